@@ -1,0 +1,119 @@
+// Plain data types shared by every stage of the detector. No PCL, no gRPC:
+// this header is included everywhere, so it stays light.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "absl/status/status.h"
+
+namespace cornerpose {
+
+// A point cloud in the camera frame (x right, y down, z forward), metres.
+// Organized when height > 1: point (u, v) is xyz[v * width + u], and a pixel
+// without a return holds NaN in all three coordinates. Unorganized clouds have
+// height == 1 and may still contain NaN points (they are ignored).
+struct PointCloud {
+  int width = 0;
+  int height = 0;
+  std::vector<Eigen::Vector3f> xyz;
+
+  bool organized() const { return height > 1; }
+  size_t size() const { return xyz.size(); }
+  bool empty() const { return xyz.empty(); }
+  static bool IsValid(const Eigen::Vector3f& p) { return std::isfinite(p.z()); }
+
+  // OK when width * height == xyz.size() and both are positive (or all zero).
+  absl::Status Validate() const;
+};
+
+// Pinhole intrinsics of a depth camera, in pixels.
+struct CameraIntrinsics {
+  int width = 640;
+  int height = 480;
+  double fx = 525.0;
+  double fy = 525.0;
+  double cx = 319.5;
+  double cy = 239.5;
+
+  absl::Status Validate() const;
+};
+
+// The known size of the boxes to find, metres: l along the box x axis,
+// b along y, h along z.
+struct BoxDims {
+  double l = 0.0;
+  double b = 0.0;
+  double h = 0.0;
+
+  double operator[](int axis) const { return axis == 0 ? l : axis == 1 ? b : h; }
+  Eigen::Vector3d vec() const { return {l, b, h}; }
+  // INVALID_ARGUMENT when a side is not finite, <= 0, or above 10 m.
+  absl::Status Validate() const;
+};
+
+// One of the six faces of a box: +x is the face at x = +l/2, and so on.
+enum class BoxFace : uint8_t { kPlusX = 0, kMinusX, kPlusY, kMinusY, kPlusZ, kMinusZ };
+const char* BoxFaceName(BoxFace face);  // "+x", "-x", ...
+// Outward unit normal of a face in the box frame.
+Eigen::Vector3d BoxFaceNormal(BoxFace face);
+
+// An edge segment found in the edge points: two extremities and its support.
+struct EdgeSegment {
+  Eigen::Vector3f end1 = Eigen::Vector3f::Zero();  // camera frame, m
+  Eigen::Vector3f end2 = Eigen::Vector3f::Zero();  // camera frame, m
+  Eigen::Vector3f point = Eigen::Vector3f::Zero();      // a point on the fitted line, m
+  Eigen::Vector3f direction = Eigen::Vector3f::UnitX();  // unit, end1 -> end2
+  int num_points = 0;                                   // edge points assigned to it
+
+  float length() const { return (end2 - end1).norm(); }
+};
+
+// Where two perpendicular edge segments meet.
+struct Corner {
+  Eigen::Vector3f position = Eigen::Vector3f::Zero();  // camera frame, m
+  int segment_a = -1;  // index into the segment list
+  int segment_b = -1;
+  bool a_at_end1 = true;  // which extremity of segment_a meets
+  bool b_at_end1 = true;
+};
+
+// A box found in the cloud.
+struct DetectedBox {
+  Eigen::Isometry3d camera_T_box = Eigen::Isometry3d::Identity();
+  // Confidence in [0, 1]: the share of the box's expected visible surface
+  // that the cloud confirms, lowered by contradicting evidence.
+  double score = 0.0;
+  BoxFace grasp_face = BoxFace::kPlusZ;           // the face that looks at the camera
+  Eigen::Vector3d grasp_centre_camera = Eigen::Vector3d::Zero();  // its centre, m
+  Eigen::Vector3d grasp_normal_camera = Eigen::Vector3d::Zero();  // its outward normal
+  std::vector<int> segments;  // edge segments that support the box
+  int num_corners = 0;        // corners used for its pose
+};
+
+// Wall-clock time of each stage, milliseconds.
+struct StageTimings {
+  double preprocess_ms = 0.0;
+  double edge_points_ms = 0.0;
+  double edge_segments_ms = 0.0;
+  double clubbing_ms = 0.0;
+  double poses_ms = 0.0;
+  double total_ms = 0.0;
+};
+
+// Everything the detector found in one frame.
+struct Detection {
+  std::vector<Eigen::Vector3f> edge_points;  // camera frame, m
+  std::vector<EdgeSegment> segments;
+  std::vector<Corner> corners;
+  std::vector<DetectedBox> boxes;  // best score first
+  StageTimings timings;
+};
+
+}  // namespace cornerpose
