@@ -1,0 +1,113 @@
+#include "common/perception/box_evidence.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "absl/strings/str_cat.h"
+#include "common/perception/box_pose.h"
+
+namespace cornerpose {
+
+absl::Status EvidenceOptions::Validate() const {
+  if (!(depth_tolerance_base_m > 0.0 && depth_tolerance_base_m <= 0.2)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "depth_tolerance_base_m=", depth_tolerance_base_m, " is outside (0, 0.2] m"));
+  }
+  if (!(depth_tolerance_per_m2 >= 0.0 && depth_tolerance_per_m2 <= 0.2)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "depth_tolerance_per_m2=", depth_tolerance_per_m2, " is outside [0, 0.2] 1/m"));
+  }
+  if (max_samples < 10 || max_samples > 10000000) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("evidence max_samples=", max_samples, " is outside [10, 1e7]"));
+  }
+  return absl::OkStatus();
+}
+
+BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_T_box,
+                       const BoxDims& dims, const EvidenceOptions& options) {
+  BoxEvidence ev;
+  const CameraIntrinsics& k = depth.camera;
+  // Screen-space bounds of the box.
+  double u0 = std::numeric_limits<double>::max(), v0 = u0, u1 = -u0, v1 = -u0;
+  for (const Eigen::Vector3d& c : BoxCorners(camera_T_box, dims)) {
+    if (c.z() <= 0.05) {
+      ev.in_front_of_camera = false;
+      return ev;
+    }
+    const Eigen::Vector2d px = Project(k, c);
+    u0 = std::min(u0, px.x()), u1 = std::max(u1, px.x());
+    v0 = std::min(v0, px.y()), v1 = std::max(v1, px.y());
+  }
+  const int ua = std::max(0, static_cast<int>(std::floor(u0)));
+  const int ub = std::min(k.width - 1, static_cast<int>(std::ceil(u1)));
+  const int va = std::max(0, static_cast<int>(std::floor(v0)));
+  const int vb = std::min(k.height - 1, static_cast<int>(std::ceil(v1)));
+  if (ua > ub || va > vb) return ev;
+  const double area = static_cast<double>(ub - ua + 1) * (vb - va + 1);
+  const int step = std::max(1, static_cast<int>(std::sqrt(area / options.max_samples)));
+
+  // Ray casting in the box frame (slab method).
+  const Eigen::Matrix3d box_R_camera = camera_T_box.linear().transpose();
+  const Eigen::Vector3d origin = -(box_R_camera * camera_T_box.translation());
+  const Eigen::Vector3d half = 0.5 * dims.vec();
+  std::array<int, 6> face_px{};
+  for (int v = va; v <= vb; v += step) {
+    for (int u = ua; u <= ub; u += step) {
+      const Eigen::Vector3d dir = box_R_camera * PixelRay(k, u, v);
+      double t_near = -std::numeric_limits<double>::max(), t_far = std::numeric_limits<double>::max();
+      int near_axis = -1;
+      bool hit = true;
+      for (int a = 0; a < 3 && hit; ++a) {
+        if (std::abs(dir[a]) < 1e-12) {
+          hit = std::abs(origin[a]) <= half[a];
+          continue;
+        }
+        double t1 = (-half[a] - origin[a]) / dir[a], t2 = (half[a] - origin[a]) / dir[a];
+        if (t1 > t2) std::swap(t1, t2);
+        if (t1 > t_near) {
+          t_near = t1;
+          near_axis = a;
+        }
+        t_far = std::min(t_far, t2);
+        hit = t_near <= t_far;
+      }
+      if (!hit || near_axis < 0 || t_near <= 0.0) continue;
+      // The ray enters through the face on the side it comes from.
+      const int face = 2 * near_axis + (dir[near_axis] < 0.0 ? 0 : 1);
+      FaceEvidence& f = ev.faces[face];
+      ++face_px[face];
+      ++f.expected;
+      const double z_model = t_near;  // rays have unit z
+      const float z = depth.at(u, v);
+      if (std::isnan(z)) {
+        ++f.missing;
+        continue;
+      }
+      const double tol =
+          options.depth_tolerance_base_m + options.depth_tolerance_per_m2 * z_model * z_model;
+      if (z < z_model - tol) {
+        ++f.occluded;
+      } else if (z > z_model + tol) {
+        ++f.see_through;
+      } else {
+        ++f.agree;
+      }
+    }
+  }
+  int best = 0;
+  for (int f = 0; f < 6; ++f) {
+    if (face_px[f] > face_px[best]) best = f;
+    FaceEvidence& t = ev.total;
+    t.expected += ev.faces[f].expected;
+    t.agree += ev.faces[f].agree;
+    t.occluded += ev.faces[f].occluded;
+    t.see_through += ev.faces[f].see_through;
+    t.missing += ev.faces[f].missing;
+  }
+  ev.grasp_face = static_cast<BoxFace>(best);
+  return ev;
+}
+
+}  // namespace cornerpose

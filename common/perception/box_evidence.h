@@ -1,0 +1,56 @@
+// What the depth image says about a box hypothesis: the box is rendered into
+// the camera by ray casting and each pixel it covers is compared with the
+// measured depth. A real box is confirmed on its visible faces; a wrong one
+// is contradicted by pixels seen *through* it (points inside its volume or
+// behind it) and by faces the camera should see but that return nothing.
+#pragma once
+
+#include "absl/status/status.h"
+#include "common/perception/camera_model.h"
+#include "common/perception/types.h"
+
+namespace cornerpose {
+
+struct EvidenceOptions {
+  // A measured depth agrees with the rendered one within
+  // base + per_m2 * z^2 (the Kinect's error grows with z^2). Metres, 1/metre.
+  double depth_tolerance_base_m = 0.008;
+  double depth_tolerance_per_m2 = 0.004;
+  // At most this many pixels are tested per box (a regular subsample). Count.
+  int max_samples = 3000;
+
+  absl::Status Validate() const;
+};
+
+struct FaceEvidence {
+  int expected = 0;     // pixels where the rendered box shows this face
+  int agree = 0;        // ... and the measured depth matches it
+  int occluded = 0;     // ... measured in front of it (something on top)
+  int see_through = 0;  // ... measured behind it (free space where the box would be)
+  int missing = 0;      // ... no return
+  int visible() const { return expected - occluded; }
+};
+
+struct BoxEvidence {
+  std::array<FaceEvidence, 6> faces;  // by BoxFace
+  FaceEvidence total;
+  BoxFace grasp_face = BoxFace::kPlusZ;  // the face with the most rendered pixels
+  bool in_front_of_camera = true;
+
+  // Share of the box's unoccluded pixels that the measurement confirms.
+  double support() const {
+    return total.visible() > 0 ? static_cast<double>(total.agree) / total.visible() : 0.0;
+  }
+  double see_through_fraction() const {
+    return total.expected > 0 ? static_cast<double>(total.see_through) / total.expected : 1.0;
+  }
+  double visible_fraction() const {
+    return total.expected > 0 ? static_cast<double>(total.visible()) / total.expected : 0.0;
+  }
+  const FaceEvidence& grasp() const { return faces[static_cast<int>(grasp_face)]; }
+};
+
+BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_T_box,
+                       const BoxDims& dims, const EvidenceOptions& options);
+
+}  // namespace cornerpose

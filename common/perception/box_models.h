@@ -1,0 +1,19 @@
+// Named box sizes, so callers can say "carton_s" instead of three numbers.
+#pragma once
+
+#include "absl/strings/string_view.h"
+
+#include "absl/status/statusor.h"
+#include "common/perception/types.h"
+
+namespace cornerpose {
+
+// The built-in models (l x b x h, metres): brick 0.19 x 0.09 x 0.057,
+// carton_s 0.30 x 0.20 x 0.15, carton_l 0.40 x 0.30 x 0.25,
+// carton_sq 0.25 x 0.25 x 0.20, carton_flat 0.30 x 0.20 x 0.10.
+absl::StatusOr<BoxDims> BoxModelByName(absl::string_view name);
+
+// Parses "L,B,H" in metres, or a model name; validates the result.
+absl::StatusOr<BoxDims> ParseBoxDims(absl::string_view text);
+
+}  // namespace cornerpose

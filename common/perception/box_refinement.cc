@@ -1,0 +1,296 @@
+#include "common/perception/box_refinement.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <optional>
+
+#include <Eigen/Eigenvalues>
+
+#include "absl/strings/str_cat.h"
+
+namespace cornerpose {
+namespace {
+
+double Median(std::vector<double>& v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+struct FacePoint {
+  double a, b, n;  // coordinates in the face frame, metres
+};
+
+// The face frame: centre c, outward normal n, in-plane axes a and b.
+struct FaceFrame {
+  Eigen::Vector3d c, n, a, b;
+  double half_a, half_b;
+  int axis_a, axis_b, axis_n;
+  double sign_n;
+};
+
+FaceFrame MakeFaceFrame(const Eigen::Isometry3d& camera_T_box, const BoxDims& dims, BoxFace face) {
+  FaceFrame f;
+  const int fi = static_cast<int>(face);
+  f.axis_n = fi / 2;
+  f.sign_n = fi % 2 == 0 ? 1.0 : -1.0;
+  f.axis_a = (f.axis_n + 1) % 3;
+  f.axis_b = (f.axis_n + 2) % 3;
+  const Eigen::Matrix3d R = camera_T_box.linear();
+  f.n = f.sign_n * R.col(f.axis_n);
+  f.a = R.col(f.axis_a);
+  f.b = R.col(f.axis_b);
+  f.half_a = dims[f.axis_a] / 2.0;
+  f.half_b = dims[f.axis_b] / 2.0;
+  f.c = camera_T_box.translation() + f.n * dims[f.axis_n] / 2.0;
+  return f;
+}
+
+// Measured points near the face, in face coordinates.
+std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margin,
+                                         double plane_tol) {
+  const CameraIntrinsics& k = depth.camera;
+  double u0 = std::numeric_limits<double>::max(), v0 = u0, u1 = -u0, v1 = -u0;
+  for (double sa : {-1.0, 1.0}) {
+    for (double sb : {-1.0, 1.0}) {
+      const Eigen::Vector3d p = f.c + sa * (f.half_a + margin) * f.a + sb * (f.half_b + margin) * f.b;
+      if (p.z() <= 0.05) return {};
+      const Eigen::Vector2d px = Project(k, p);
+      u0 = std::min(u0, px.x()), u1 = std::max(u1, px.x());
+      v0 = std::min(v0, px.y()), v1 = std::max(v1, px.y());
+    }
+  }
+  const int ua = std::max(0, static_cast<int>(std::floor(u0)));
+  const int ub = std::min(k.width - 1, static_cast<int>(std::ceil(u1)));
+  const int va = std::max(0, static_cast<int>(std::floor(v0)));
+  const int vb = std::min(k.height - 1, static_cast<int>(std::ceil(v1)));
+  std::vector<FacePoint> pts;
+  for (int v = va; v <= vb; ++v) {
+    for (int u = ua; u <= ub; ++u) {
+      const float z = depth.at(u, v);
+      if (std::isnan(z)) continue;
+      const Eigen::Vector3d d = z * PixelRay(k, u, v) - f.c;
+      const FacePoint q{d.dot(f.a), d.dot(f.b), d.dot(f.n)};
+      if (std::abs(q.n) > plane_tol) continue;
+      if (std::abs(q.a) > f.half_a + margin || std::abs(q.b) > f.half_b + margin) continue;
+      pts.push_back(q);
+    }
+  }
+  return pts;
+}
+
+// One side of the face: where it ends along `sign * a` (or b), and its turn.
+struct SideMeasure {
+  SideKind kind = SideKind::kUnknown;
+  double position = 0.0;  // along the side's normal axis, face coordinates
+  double slope = 0.0;     // d(position)/d(along), turn of the side (free sides)
+  bool measured() const { return kind == SideKind::kFree || kind == SideKind::kSeam; }
+};
+
+// Looks for the groove two touching boxes leave between coplanar faces
+// (rounded edges, a gap): the mean height over the plane across the side, in
+// 2 mm bins, dips at the seam. Returns the seam's position or nothing.
+std::optional<double> FindSeam(const std::vector<FacePoint>& pts, bool along_a, double sign,
+                               double half, double half_other, const RefinementOptions& o) {
+  constexpr double kBin = 0.002;
+  const double reach = o.side_band_m;
+  const int nbins = static_cast<int>(2.0 * reach / kBin);
+  std::vector<double> sum(nbins, 0.0);
+  std::vector<int> count(nbins, 0);
+  for (const FacePoint& p : pts) {
+    const double across = sign * (along_a ? p.a : p.b) - half;
+    const double along = along_a ? p.b : p.a;
+    if (std::abs(along) > half_other - reach || std::abs(across) >= reach) continue;
+    const int k = static_cast<int>((across + reach) / kBin);
+    sum[k] += p.n;
+    ++count[k];
+  }
+  std::vector<double> mean(nbins, 0.0);
+  for (int k = 0; k < nbins; ++k) {
+    if (count[k] < 5) return std::nullopt;
+    mean[k] = sum[k] / count[k];
+  }
+  // Deepest 3-bin window, compared with the flanks beyond 6 mm from it.
+  int best = -1;
+  double best_depth = 0.0;
+  // Only near the hypothesised side: a dip anywhere in the band would
+  // often be noise (the Kinect's depth noise is spatially correlated).
+  const int lo = std::max(1, static_cast<int>((reach - o.seam_search_m) / kBin));
+  const int hi = std::min(nbins - 2, static_cast<int>((reach + o.seam_search_m) / kBin));
+  for (int k = lo; k <= hi; ++k) {
+    const double centre = (mean[k - 1] + mean[k] + mean[k + 1]) / 3.0;
+    double flank = 0.0;
+    int nf = 0;
+    for (int j = 0; j < nbins; ++j) {
+      if (std::abs(j - k) * kBin >= 0.006 && std::abs(j - k) * kBin <= 0.014) {
+        flank += mean[j];
+        ++nf;
+      }
+    }
+    if (nf < 4) continue;
+    const double depth = flank / nf - centre;
+    if (depth > best_depth) {
+      best_depth = depth;
+      best = k;
+    }
+  }
+  if (best < 0 || best_depth < o.min_seam_depth_m) return std::nullopt;
+  return half + (best + 0.5) * kBin - reach;
+}
+
+SideMeasure MeasureSide(const std::vector<FacePoint>& pts, bool along_a, double sign, double half,
+                        double half_other, const RefinementOptions& o) {
+  const double band = o.side_band_m;
+  int inner = 0, outer = 0;
+  const double bin = 0.01;
+  const int nbins = std::max(1, static_cast<int>(2.0 * (half_other - band) / bin));
+  std::vector<double> best(nbins, -std::numeric_limits<double>::max());
+  for (const FacePoint& p : pts) {
+    const double across = sign * (along_a ? p.a : p.b);  // outward coordinate
+    const double along = along_a ? p.b : p.a;
+    if (std::abs(along) > half_other - band) continue;
+    if (across > half + 0.005 && across <= half + band) ++outer;
+    if (across >= half - band && across < half - 0.005) ++inner;
+    if (across >= half - band && across <= half + band) {
+      const int k = std::clamp(static_cast<int>((along + half_other - band) / bin), 0, nbins - 1);
+      best[k] = std::max(best[k], across);
+    }
+  }
+  SideMeasure m;
+  if (inner < 10) return m;  // hidden or cut: no say
+  if (outer > o.free_side_ratio * inner) {
+    // The face continues past the side: a seam to a touching box, or the
+    // hypothesis is too small for this face.
+    if (std::optional<double> seam = FindSeam(pts, along_a, sign, half, half_other, o)) {
+      m.kind = SideKind::kSeam;
+      m.position = *seam;
+    } else {
+      m.kind = SideKind::kContinues;
+    }
+    return m;
+  }
+  // Outermost point per bin, then a robust line through them.
+  std::vector<std::pair<double, double>> ends;  // (along, across)
+  for (int k = 0; k < nbins; ++k) {
+    if (best[k] > -1.0) ends.emplace_back(-half_other + band + (k + 0.5) * bin, best[k]);
+  }
+  if (static_cast<int>(ends.size()) < std::max(3, nbins / 3)) return m;
+  std::vector<double> across;
+  for (auto& e : ends) across.push_back(e.second);
+  m.position = Median(across);
+  // Slope by the median of pairwise slopes (Theil-Sen) over bins far apart.
+  std::vector<double> slopes;
+  for (size_t i = 0; i < ends.size(); ++i) {
+    for (size_t j = i + 1; j < ends.size(); ++j) {
+      const double dl = ends[j].first - ends[i].first;
+      if (dl > 0.03) slopes.push_back((ends[j].second - ends[i].second) / dl);
+    }
+  }
+  m.slope = slopes.empty() ? 0.0 : Median(slopes);
+  m.kind = SideKind::kFree;
+  return m;
+}
+
+}  // namespace
+
+absl::Status RefinementOptions::Validate() const {
+  if (!(plane_tolerance_m > 0.0 && plane_tolerance_m <= 0.2) ||
+      !(side_band_m > 0.005 && side_band_m <= 0.2) ||
+      !(free_side_ratio >= 0.0 && free_side_ratio <= 1.0) || iterations < 0 || iterations > 20 ||
+      !(max_shift_m > 0.0) || !(max_turn_deg > 0.0)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "refinement options out of range: plane_tolerance_m=", plane_tolerance_m,
+        " side_band_m=", side_band_m, " free_side_ratio=", free_side_ratio,
+        " iterations=", iterations));
+  }
+  return absl::OkStatus();
+}
+
+RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face,
+                                   const RefinementOptions& options,
+                                   Eigen::Isometry3d* camera_T_box) {
+  RefinementResult result;
+  const Eigen::Isometry3d initial = *camera_T_box;
+  Eigen::Isometry3d pose = initial;
+  for (int it = 0; it < std::max(1, options.iterations); ++it) {
+    FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
+    const std::vector<FacePoint> pts =
+        CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m);
+    // Plane through the interior points.
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    int n = 0;
+    for (const FacePoint& p : pts) {
+      if (std::abs(p.a) > f.half_a - 0.01 || std::abs(p.b) > f.half_b - 0.01) continue;
+      mean += Eigen::Vector3d(p.a, p.b, p.n);
+      ++n;
+    }
+    if (n < 30) return result;
+    mean /= n;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const FacePoint& p : pts) {
+      if (std::abs(p.a) > f.half_a - 0.01 || std::abs(p.b) > f.half_b - 0.01) continue;
+      const Eigen::Vector3d d = Eigen::Vector3d(p.a, p.b, p.n) - mean;
+      cov += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    Eigen::Vector3d normal_local = eig.eigenvectors().col(0);
+    if (normal_local.z() < 0.0) normal_local = -normal_local;
+    result.plane_rms_m = std::sqrt(std::max(0.0, eig.eigenvalues()(0)) / n);
+    result.face_points = n;
+
+    // Sides: +a, -a, +b, -b.
+    const SideMeasure pa = MeasureSide(pts, true, 1.0, f.half_a, f.half_b, options);
+    const SideMeasure ma = MeasureSide(pts, true, -1.0, f.half_a, f.half_b, options);
+    const SideMeasure pb = MeasureSide(pts, false, 1.0, f.half_b, f.half_a, options);
+    const SideMeasure mb = MeasureSide(pts, false, -1.0, f.half_b, f.half_a, options);
+    result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
+    result.free_sides = 0;
+    for (SideKind k : result.sides) result.free_sides += k == SideKind::kFree;
+    auto offset = [](const SideMeasure& plus, const SideMeasure& minus, double half) {
+      if (plus.measured() && minus.measured()) return 0.5 * (plus.position - minus.position);
+      if (plus.measured()) return plus.position - half;
+      if (minus.measured()) return half - minus.position;
+      return 0.0;
+    };
+    const double da = offset(pa, ma, f.half_a);
+    const double db = offset(pb, mb, f.half_b);
+    result.extent_a_m = pa.measured() && ma.measured() ? pa.position + ma.position : 0.0;
+    result.extent_b_m = pb.measured() && mb.measured() ? pb.position + mb.position : 0.0;
+    // Turn about the normal: a side along b (the +-a sides) turning by
+    // slope s means the a axis turns by -s toward b... average all sides.
+    std::vector<double> turns;
+    if (pa.kind == SideKind::kFree) turns.push_back(-pa.slope);
+    if (ma.kind == SideKind::kFree) turns.push_back(ma.slope);
+    if (pb.kind == SideKind::kFree) turns.push_back(pb.slope);
+    if (mb.kind == SideKind::kFree) turns.push_back(-mb.slope);
+    double turn = 0.0;
+    if (!turns.empty()) turn = std::atan(Median(turns));
+
+    // New face frame.
+    const Eigen::Vector3d n_cam =
+        (normal_local.x() * f.a + normal_local.y() * f.b + normal_local.z() * f.n).normalized();
+    Eigen::Vector3d a_cam = (std::cos(turn) * f.a + std::sin(turn) * f.b);
+    a_cam = (a_cam - a_cam.dot(n_cam) * n_cam).normalized();
+    const Eigen::Vector3d b_cam = f.sign_n * n_cam.cross(a_cam);  // keeps R right-handed
+    const Eigen::Vector3d mean_cam = f.c + mean.x() * f.a + mean.y() * f.b + mean.z() * f.n;
+    Eigen::Vector3d centre = f.c + da * f.a + db * f.b;
+    centre += (mean_cam - centre).dot(n_cam) * n_cam;  // onto the fitted plane
+
+    Eigen::Matrix3d R;
+    R.col(f.axis_n) = f.sign_n * n_cam;
+    R.col(f.axis_a) = a_cam;
+    R.col(f.axis_b) = b_cam;
+    pose.linear() = R;
+    pose.translation() = centre - n_cam * dims[f.axis_n] / 2.0;
+  }
+  const double shift = (pose.translation() - initial.translation()).norm();
+  const double turn_deg =
+      Eigen::AngleAxisd(initial.linear().transpose() * pose.linear()).angle() * 180.0 / std::numbers::pi;
+  if (shift > options.max_shift_m || turn_deg > options.max_turn_deg) return result;
+  *camera_T_box = pose;
+  result.ok = true;
+  return result;
+}
+
+}  // namespace cornerpose

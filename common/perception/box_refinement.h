@@ -1,0 +1,68 @@
+// Pose refinement on the grasp face: corners come from the blurred edge
+// bands and are good to a centimetre or so; the face the camera looks at has
+// hundreds of points. The face's plane fixes its normal and depth, and each
+// free side of it (where the face ends in a depth jump, not in a coplanar
+// neighbour) fixes the face's position and turn in its own plane.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "absl/status/status.h"
+#include "common/perception/camera_model.h"
+#include "common/perception/types.h"
+
+namespace cornerpose {
+
+struct RefinementOptions {
+  // Points within this distance of the face's plane belong to it. Metres.
+  double plane_tolerance_m = 0.015;
+  // Band outside a side searched for a coplanar continuation, and the
+  // margin kept clear of corners when measuring a side. Metres.
+  double side_band_m = 0.02;
+  // A side is free when its outer band holds fewer coplanar points than this
+  // share of its inner band. Unitless.
+  double free_side_ratio = 0.15;
+  // Least depth of the groove between two touching coplanar faces. Metres.
+  // Fine seams (gaps under ~2 mm) are too shallow to tell from the depth
+  // noise; they are left to other evidence rather than guessed.
+  double min_seam_depth_m = 0.0015;
+  // The groove is looked for this far either side of the hypothesised side.
+  // Metres.
+  double seam_search_m = 0.006;
+  // Iterations of measure-and-update. Count.
+  int iterations = 3;
+  // Largest correction accepted, beyond which the hypothesis is not this
+  // box: metres and degrees.
+  double max_shift_m = 0.05;
+  double max_turn_deg = 12.0;
+
+  absl::Status Validate() const;
+};
+
+// What lies beyond one side of the grasp face.
+enum class SideKind : uint8_t {
+  kUnknown,    // too few points near the side (hidden or out of view)
+  kFree,       // the face ends: a depth jump, a crease or no return
+  kSeam,       // a coplanar face continues past a groove: a touching box
+  kContinues,  // the face goes on, flat: the box is not this size here
+};
+
+struct RefinementResult {
+  std::array<SideKind, 4> sides{};  // +a, -a, +b, -b of the grasp face
+  bool ok = false;
+  int free_sides = 0;     // of the grasp face's four
+  int face_points = 0;    // points on the grasp face
+  double plane_rms_m = 0.0;
+  // Measured extent of the face between two free sides along its two axes,
+  // or 0 where a side is not free. Metres.
+  double extent_a_m = 0.0;
+  double extent_b_m = 0.0;
+};
+
+// Refines camera_T_box in place using the face `grasp_face`.
+RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face,
+                                   const RefinementOptions& options,
+                                   Eigen::Isometry3d* camera_T_box);
+
+}  // namespace cornerpose

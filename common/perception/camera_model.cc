@@ -1,0 +1,90 @@
+#include "common/perception/camera_model.h"
+
+#include <cmath>
+#include <limits>
+
+#include "absl/strings/str_cat.h"
+
+namespace cornerpose {
+namespace {
+
+// Fits s = (i - c)/f, i.e. i = f*s + c, by least squares.
+bool FitLine(double n, double s, double ss, double i, double si, double* f, double* c) {
+  const double det = n * ss - s * s;
+  if (n < 100 || std::abs(det) < 1e-12 * n * n) return false;
+  *f = (n * si - s * i) / det;
+  *c = (i - *f * s) / n;
+  return std::isfinite(*f) && *f > 0.0;
+}
+
+}  // namespace
+
+absl::StatusOr<CameraIntrinsics> EstimateIntrinsics(const PointCloud& cloud) {
+  if (!cloud.organized()) {
+    return absl::FailedPreconditionError("intrinsics can only be recovered from organized clouds");
+  }
+  // Sums for u ~ fx*(x/z) + cx and v ~ fy*(y/z) + cy over a sparse grid.
+  double n = 0, sx = 0, sxx = 0, su = 0, sxu = 0, sy = 0, syy = 0, sv = 0, syv = 0;
+  const int step = std::max(1, static_cast<int>(std::sqrt(cloud.size() / 20000.0)));
+  for (int v = 0; v < cloud.height; v += step) {
+    for (int u = 0; u < cloud.width; u += step) {
+      const Eigen::Vector3f& p = cloud.xyz[static_cast<size_t>(v) * cloud.width + u];
+      if (!PointCloud::IsValid(p) || p.z() <= 0.0f) continue;
+      const double a = p.x() / p.z(), b = p.y() / p.z();
+      n += 1;
+      sx += a, sxx += a * a, su += u, sxu += a * u;
+      sy += b, syy += b * b, sv += v, syv += b * v;
+    }
+  }
+  CameraIntrinsics k;
+  k.width = cloud.width;
+  k.height = cloud.height;
+  if (!FitLine(n, sx, sxx, su, sxu, &k.fx, &k.cx) || !FitLine(n, sy, syy, sv, syv, &k.fy, &k.cy)) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("too few valid points (", n, ") to recover the camera intrinsics"));
+  }
+  return k;
+}
+
+DepthImage MakeDepthImage(const PointCloud& cloud, const CameraIntrinsics& k) {
+  DepthImage image;
+  image.camera = k;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  if (cloud.organized() && cloud.width == k.width && cloud.height == k.height) {
+    image.z.resize(cloud.size());
+    for (size_t i = 0; i < cloud.size(); ++i) {
+      image.z[i] = PointCloud::IsValid(cloud.xyz[i]) ? cloud.xyz[i].z() : nan;
+    }
+    return image;
+  }
+  image.z.assign(static_cast<size_t>(k.width) * k.height, nan);
+  for (const Eigen::Vector3f& p : cloud.xyz) {
+    if (!PointCloud::IsValid(p) || p.z() <= 0.0f) continue;
+    const Eigen::Vector2d px = Project(k, p.cast<double>());
+    const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+    if (!image.inside(u, v)) continue;
+    float& z = image.z[static_cast<size_t>(v) * k.width + u];
+    if (std::isnan(z) || p.z() < z) z = p.z();
+  }
+  return image;
+}
+
+PointCloud OrganizeByProjection(const PointCloud& cloud, const CameraIntrinsics& k) {
+  if (cloud.organized()) return cloud;
+  PointCloud out;
+  out.width = k.width;
+  out.height = k.height;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  out.xyz.assign(static_cast<size_t>(k.width) * k.height, Eigen::Vector3f(nan, nan, nan));
+  for (const Eigen::Vector3f& p : cloud.xyz) {
+    if (!PointCloud::IsValid(p) || p.z() <= 0.0f) continue;
+    const Eigen::Vector2d px = Project(k, p.cast<double>());
+    const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+    if (u < 0 || v < 0 || u >= k.width || v >= k.height) continue;
+    Eigen::Vector3f& slot = out.xyz[static_cast<size_t>(v) * k.width + u];
+    if (!PointCloud::IsValid(slot) || p.z() < slot.z()) slot = p;
+  }
+  return out;
+}
+
+}  // namespace cornerpose

@@ -1,0 +1,43 @@
+// The pinhole camera behind a frame: recovered from an organized cloud, and
+// used to project hypotheses back into the image.
+#pragma once
+
+#include "absl/status/statusor.h"
+#include "common/perception/types.h"
+
+namespace cornerpose {
+
+// Recovers fx, fy, cx, cy from an organized cloud by least squares on
+// x/z = (u - cx)/fx and y/z = (v - cy)/fy over its valid pixels. Exact for a
+// cloud made by a pinhole camera; FAILED_PRECONDITION when the cloud is not
+// organized or has too few valid points to fit.
+absl::StatusOr<CameraIntrinsics> EstimateIntrinsics(const PointCloud& cloud);
+
+// Pixel coordinates of a camera-frame point (z > 0 assumed).
+inline Eigen::Vector2d Project(const CameraIntrinsics& k, const Eigen::Vector3d& p) {
+  return {k.fx * p.x() / p.z() + k.cx, k.fy * p.y() / p.z() + k.cy};
+}
+
+// Unit-free ray direction (z = 1) through pixel (u, v).
+inline Eigen::Vector3d PixelRay(const CameraIntrinsics& k, double u, double v) {
+  return {(u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0};
+}
+
+// An organized depth image of a cloud: for an organized cloud its z values;
+// for an unorganized one a z-buffer of its points projected through `k`
+// (the nearest point wins a pixel). NaN where there is no return.
+struct DepthImage {
+  CameraIntrinsics camera;
+  std::vector<float> z;  // metres, row-major
+  float at(int u, int v) const { return z[static_cast<size_t>(v) * camera.width + u]; }
+  bool inside(int u, int v) const {
+    return u >= 0 && v >= 0 && u < camera.width && v < camera.height;
+  }
+};
+DepthImage MakeDepthImage(const PointCloud& cloud, const CameraIntrinsics& k);
+
+// Projects an unorganized cloud into an organized one through `k` (nearest
+// point per pixel). Organized clouds are returned unchanged.
+PointCloud OrganizeByProjection(const PointCloud& cloud, const CameraIntrinsics& k);
+
+}  // namespace cornerpose

@@ -1,0 +1,204 @@
+#include "common/perception/detector.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "common/perception/camera_model.h"
+#include "common/perception/internal/box_overlap.h"
+
+namespace cornerpose {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double MsSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+struct Candidate {
+  DetectedBox box;
+  BoxEvidence evidence;
+  RefinementResult refinement;
+};
+
+// Judges a refined hypothesis; returns its score, or < 0 when rejected.
+double Judge(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
+             BoxFace grasp, const AcceptanceOptions& o) {
+  if (!ev.in_front_of_camera || !ref.ok) return -1.0;
+  const FaceEvidence& g = ev.faces[static_cast<int>(grasp)];
+  if (g.expected < o.min_grasp_pixels) return -1.0;
+  const double grasp_occluded = static_cast<double>(g.occluded) / g.expected;
+  const double grasp_support = g.visible() > 0 ? static_cast<double>(g.agree) / g.visible() : 0.0;
+  if (grasp_occluded > o.max_grasp_occluded || grasp_support < o.min_grasp_support) return -1.0;
+  if (ev.support() < o.min_support || ev.see_through_fraction() > o.max_see_through) return -1.0;
+  // The in-plane position must be measured, not guessed: a free side along
+  // each of the face's axes.
+  const int fi = static_cast<int>(grasp);
+  const int axis_a = (fi / 2 + 1) % 3, axis_b = (fi / 2 + 2) % 3;
+  if (ref.extent_a_m > 0.0 && std::abs(ref.extent_a_m - dims[axis_a]) > o.extent_tolerance_m) {
+    return -1.0;
+  }
+  if (ref.extent_b_m > 0.0 && std::abs(ref.extent_b_m - dims[axis_b]) > o.extent_tolerance_m) {
+    return -1.0;
+  }
+  // Every side that can be seen must end the face: a free border or a seam
+  // to a touching box. A face that runs on flat is a bigger face.
+  int measured = 0;
+  for (SideKind k : ref.sides) {
+    if (k == SideKind::kContinues) return -1.0;
+    measured += k == SideKind::kFree || k == SideKind::kSeam;
+  }
+  if (ref.free_sides < 1 || measured < 2) return -1.0;
+  return std::clamp(0.5 * grasp_support + 0.5 * ev.support() - 2.0 * ev.see_through_fraction() -
+                        0.25 * grasp_occluded,
+                    0.0, 1.0);
+}
+
+}  // namespace
+
+absl::Status AcceptanceOptions::Validate() const {
+  for (double v : {min_support, min_grasp_support, max_grasp_occluded, max_see_through}) {
+    if (!(v >= 0.0 && v <= 1.0)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("acceptance fraction ", v, " is outside [0, 1]"));
+    }
+  }
+  if (min_grasp_pixels < 1 || !(extent_tolerance_m > 0.0) || !(overlap_margin_m >= 0.0)) {
+    return absl::InvalidArgumentError("acceptance limits out of range");
+  }
+  return absl::OkStatus();
+}
+
+absl::Status DetectorOptions::Validate() const {
+  if (absl::Status s = box.Validate(); !s.ok()) return s;
+  for (absl::Status s : {edge_points.Validate(), segments.Validate(), clubbing.Validate(),
+                         pose.Validate(), refinement.Validate(), evidence.Validate(),
+                         acceptance.Validate()}) {
+    if (!s.ok()) return s;
+  }
+  if (camera) {
+    if (absl::Status s = camera->Validate(); !s.ok()) return s;
+  }
+  if (num_threads < 1 || num_threads > 256) {
+    return absl::InvalidArgumentError(absl::StrCat("num_threads=", num_threads, " is outside [1, 256]"));
+  }
+  if (max_points < 1) return absl::InvalidArgumentError("max_points must be positive");
+  return absl::OkStatus();
+}
+
+absl::StatusOr<Detection> DetectBoxes(const PointCloud& cloud, const DetectorOptions& options_in) {
+  const Clock::time_point t_start = Clock::now();
+  if (absl::Status s = options_in.Validate(); !s.ok()) return s;
+  if (absl::Status s = cloud.Validate(); !s.ok()) return s;
+  if (cloud.size() > static_cast<size_t>(options_in.max_points)) {
+    return absl::InvalidArgumentError(absl::StrCat("cloud has ", cloud.size(),
+                                                   " points, above the limit of ",
+                                                   options_in.max_points));
+  }
+  DetectorOptions options = options_in;
+  options.edge_points.num_threads = options.num_threads;
+  Detection det;
+
+  // Preprocess: the camera and its depth image.
+  CameraIntrinsics camera = options.camera.value_or(CameraIntrinsics{});
+  if (cloud.organized()) {
+    absl::StatusOr<CameraIntrinsics> k = EstimateIntrinsics(cloud);
+    if (!k.ok()) {  // too few valid points to hold a box
+      det.timings.total_ms = MsSince(t_start);
+      return det;
+    }
+    camera = *k;
+  }
+  const DepthImage depth = MakeDepthImage(cloud, camera);
+  det.timings.preprocess_ms = MsSince(t_start);
+
+  Clock::time_point t0 = Clock::now();
+  absl::StatusOr<EdgePoints> edges = DetectEdgePoints(cloud, options.edge_points, camera.fx);
+  if (!edges.ok()) return edges.status();
+  det.edge_points = edges->points;
+  det.timings.edge_points_ms = MsSince(t0);
+
+  t0 = Clock::now();
+  absl::StatusOr<std::vector<EdgeSegment>> segments = FitEdgeSegments(det.edge_points, options.segments);
+  if (!segments.ok()) return segments.status();
+  det.segments = *std::move(segments);
+  det.timings.edge_segments_ms = MsSince(t0);
+
+  t0 = Clock::now();
+  absl::StatusOr<SegmentGroups> groups = ClubSegments(det.segments, options.clubbing);
+  if (!groups.ok()) return groups.status();
+  det.corners = groups->corners;
+  det.timings.clubbing_ms = MsSince(t0);
+
+  t0 = Clock::now();
+  // Corners of each segment's group, for the paper's corner refinement.
+  std::vector<int> group_of(det.segments.size(), -1);
+  for (size_t g = 0; g < groups->groups.size(); ++g) {
+    for (int s : groups->groups[g]) group_of[s] = static_cast<int>(g);
+  }
+  std::vector<std::vector<Eigen::Vector3d>> group_corners(groups->groups.size());
+  for (const Corner& c : det.corners) {
+    group_corners[group_of[c.segment_a]].push_back(c.position.cast<double>());
+  }
+
+  std::vector<Candidate> candidates;
+  for (const Corner& c : det.corners) {
+    const EdgeSegment& sa = det.segments[c.segment_a];
+    const EdgeSegment& sb = det.segments[c.segment_b];
+    const Eigen::Vector3d p1 = c.position.cast<double>();
+    const Eigen::Vector3d fa = (c.a_at_end1 ? sa.end2 : sa.end1).cast<double>();
+    const Eigen::Vector3d fb = (c.b_at_end1 ? sb.end2 : sb.end1).cast<double>();
+    const double la = (fa - p1).norm(), lb = (fb - p1).norm();
+    if (la < 1e-3 || lb < 1e-3) continue;
+    for (const AxisAssignment& as : MatchEdgeLengths(la, lb, options.box, options.pose)) {
+      Candidate cand;
+      cand.box.camera_T_box = PoseFromCorner(p1, fa - p1, fb - p1, as, options.box);
+      cand.box.num_corners =
+          1 + RefineWithCorners(group_corners[group_of[c.segment_a]], options.box, options.pose,
+                                &cand.box.camera_T_box);
+      cand.box.segments = {c.segment_a, c.segment_b};
+      // Cheap rejection before refinement.
+      BoxEvidence first = MeasureBox(depth, cand.box.camera_T_box, options.box, options.evidence);
+      if (!first.in_front_of_camera || first.see_through_fraction() > 0.3 ||
+          first.support() < 0.3) {
+        continue;
+      }
+      const BoxFace grasp = first.grasp_face;
+      cand.refinement =
+          RefineOnGraspFace(depth, options.box, grasp, options.refinement, &cand.box.camera_T_box);
+      cand.evidence = MeasureBox(depth, cand.box.camera_T_box, options.box, options.evidence);
+      const double score = Judge(cand.evidence, cand.refinement, options.box, grasp,
+                                 options.acceptance);
+      if (score < 0.0) continue;
+      cand.box.score = score;
+      cand.box.grasp_face = cand.evidence.grasp_face;
+      const Eigen::Vector3d n_box = BoxFaceNormal(cand.box.grasp_face);
+      const int axis = static_cast<int>(cand.box.grasp_face) / 2;
+      cand.box.grasp_normal_camera = cand.box.camera_T_box.linear() * n_box;
+      cand.box.grasp_centre_camera =
+          cand.box.camera_T_box * (n_box * options.box[axis] / 2.0);
+      candidates.push_back(std::move(cand));
+    }
+  }
+  // Best first; a box overlapping an accepted one is the same box or a
+  // contradiction, and is dropped.
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.box.score > b.box.score; });
+  for (Candidate& c : candidates) {
+    bool clash = false;
+    for (const DetectedBox& kept : det.boxes) {
+      if (internal::BoxesOverlap(kept.camera_T_box, c.box.camera_T_box, options.box,
+                                 options.acceptance.overlap_margin_m)) {
+        clash = true;
+        break;
+      }
+    }
+    if (!clash) det.boxes.push_back(std::move(c.box));
+  }
+  det.timings.poses_ms = MsSince(t0);
+  det.timings.total_ms = MsSince(t_start);
+  return det;
+}
+
+}  // namespace cornerpose

@@ -1,0 +1,66 @@
+// The whole detector: edge points -> edge segments -> corners -> box poses,
+// each pose checked against the depth image before it is returned. A wrong
+// pose is worse than a missed box (a robot acts on it), so every hypothesis
+// must be confirmed by its grasp face and not contradicted anywhere.
+#pragma once
+
+#include <optional>
+
+#include "absl/status/statusor.h"
+#include "common/perception/box_evidence.h"
+#include "common/perception/box_pose.h"
+#include "common/perception/box_refinement.h"
+#include "common/perception/clubbing.h"
+#include "common/perception/edge_points.h"
+#include "common/perception/edge_segments.h"
+#include "common/perception/types.h"
+
+namespace cornerpose {
+
+struct AcceptanceOptions {
+  // Share of the box's unoccluded rendered pixels the depth confirms. Unitless.
+  double min_support = 0.6;
+  // Share of the grasp face's unoccluded pixels the depth confirms. Unitless.
+  double min_grasp_support = 0.8;
+  // Share of the grasp face that may be hidden by something in front. Unitless.
+  double max_grasp_occluded = 0.25;
+  // Largest share of rendered pixels seen through the box (free space or
+  // points inside its volume where the box would be). Unitless.
+  double max_see_through = 0.06;
+  // Grasp face pixels needed (at the sampling the evidence uses). Count.
+  int min_grasp_pixels = 60;
+  // A face measured between two free sides must match its known size within
+  // this. Metres.
+  double extent_tolerance_m = 0.025;
+  // Two accepted boxes may not overlap by more than this (each is shrunk by
+  // it before the overlap test). Metres.
+  double overlap_margin_m = 0.015;
+
+  absl::Status Validate() const;
+};
+
+struct DetectorOptions {
+  BoxDims box;  // required: the known size of the boxes, metres
+  EdgePointOptions edge_points;
+  EdgeSegmentOptions segments;
+  ClubbingOptions clubbing;
+  PoseOptions pose;
+  RefinementOptions refinement;
+  EvidenceOptions evidence;
+  AcceptanceOptions acceptance;
+  // The camera of an unorganized cloud, used to render hypotheses; organized
+  // clouds carry their own (recovered from the points). Default: Kinect VGA.
+  std::optional<CameraIntrinsics> camera;
+  // Worker threads (edge points). Count.
+  int num_threads = 2;
+  // Frames above this many points are refused. Count.
+  int max_points = 20'000'000;
+
+  absl::Status Validate() const;
+};
+
+// Runs the detector on one cloud. Empty, all-NaN and box-free clouds give an
+// empty Detection; malformed clouds and bad options give INVALID_ARGUMENT.
+absl::StatusOr<Detection> DetectBoxes(const PointCloud& cloud, const DetectorOptions& options);
+
+}  // namespace cornerpose

@@ -1,0 +1,331 @@
+#include "common/perception/edge_points.h"
+
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "common/perception/internal/parallel.h"
+
+namespace cornerpose {
+namespace {
+
+// Per-thread output, merged in order so the result does not depend on timing.
+struct Chunk {
+  std::vector<int> indices;
+  std::vector<float> scores;
+};
+
+// A sunflower (Vogel) spiral: n points spread evenly over the unit disc. Even
+// coverage keeps a flat patch's score near 0 with few samples.
+std::vector<Eigen::Vector2f> UnitDiscPattern(int n) {
+  std::vector<Eigen::Vector2f> pattern;
+  pattern.reserve(n);
+  const float golden = std::numbers::pi_v<float> * (3.0f - std::sqrt(5.0f));
+  for (int k = 0; k < n; ++k) {
+    const float r = std::sqrt((k + 0.5f) / n);
+    const float a = k * golden;
+    pattern.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  return pattern;
+}
+
+struct NeighbourSum {
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  int count = 0;
+  void Add(const Eigen::Vector3f& d, float dist2) {
+    if (dist2 <= 0.0f) return;
+    sum += d / std::sqrt(dist2);
+    ++count;
+  }
+  float Score() const { return count > 0 ? sum.norm() / count : 0.0f; }
+};
+
+class OrganizedScorer {
+ public:
+  OrganizedScorer(const PointCloud& cloud, const EdgePointOptions& options, double focal_px)
+      : cloud_(cloud),
+        options_(options),
+        focal_px_(static_cast<float>(focal_px)),
+        radius2_(static_cast<float>(options.radius_m * options.radius_m)),
+        pattern_(UnitDiscPattern(std::max(options.max_samples, 1))) {}
+
+  // The score of pixel (u, v), or -1 where it is not scored (no return,
+  // neighbourhood cut by the frame, too few neighbours).
+  float ScoreAt(int u, int v) const {
+    const Eigen::Vector3f& p = cloud_.xyz[v * cloud_.width + u];
+    if (!PointCloud::IsValid(p) || p.z() <= 0.0f) return -1.0f;
+    const float radius_px = static_cast<float>(options_.radius_m) * focal_px_ / p.z();
+    if (CutByBorder(u, v, radius_px)) return -1.0f;
+    const NeighbourSum n = Neighbours(u, v, p, radius_px);
+    if (n.count < options_.min_neighbours) return -1.0f;
+    return n.Score();
+  }
+
+  // Coarse pass: marks grid cells (step x step pixels) whose centre pixel
+  // scores above `threshold`.
+  void MarkCoarse(int cell_row_begin, int cell_row_end, int step, float threshold,
+                  std::vector<uint8_t>* marks) const {
+    const int cells_w = (cloud_.width + step - 1) / step;
+    for (int cv = cell_row_begin; cv < cell_row_end; ++cv) {
+      for (int cu = 0; cu < cells_w; ++cu) {
+        const int u = std::min(cu * step + step / 2, cloud_.width - 1);
+        const int v = std::min(cv * step + step / 2, cloud_.height - 1);
+        (*marks)[cv * cells_w + cu] = ScoreAt(u, v) > threshold;
+      }
+    }
+  }
+
+  // Full-resolution pass over rows; with `marks`, only pixels in or next to
+  // a marked cell are scored.
+  void ScoreRows(int row_begin, int row_end, int step, const std::vector<uint8_t>* marks,
+                 Chunk* out) const {
+    const int w = cloud_.width;
+    const int cells_w = (w + step - 1) / step, cells_h = (cloud_.height + step - 1) / step;
+    for (int v = row_begin; v < row_end; ++v) {
+      for (int u = 0; u < w; ++u) {
+        if (marks != nullptr && !NearMark(*marks, u / step, v / step, cells_w, cells_h)) continue;
+        const float score = ScoreAt(u, v);
+        if (score <= options_.threshold) continue;
+        const Eigen::Vector3f& p = cloud_.xyz[v * w + u];
+        const float radius_px = static_cast<float>(options_.radius_m) * focal_px_ / p.z();
+        if (options_.occluded_side_jump_m > 0.0 && OnOccludedSide(u, v, p, 2.0f * radius_px)) {
+          continue;
+        }
+        out->indices.push_back(v * w + u);
+        out->scores.push_back(score);
+      }
+    }
+  }
+
+ private:
+  static bool NearMark(const std::vector<uint8_t>& marks, int cu, int cv, int cells_w, int cells_h) {
+    for (int y = std::max(0, cv - 1); y <= std::min(cells_h - 1, cv + 1); ++y) {
+      for (int x = std::max(0, cu - 1); x <= std::min(cells_w - 1, cu + 1); ++x) {
+        if (marks[y * cells_w + x]) return true;
+      }
+    }
+    return false;
+  }
+
+  bool UseFullDisc(float radius_px) const {
+    return options_.max_samples == 0 ||
+           std::numbers::pi_v<float> * radius_px * radius_px <= options_.max_samples;
+  }
+
+  const Eigen::Vector3f* At(int u, int v) const {
+    if (u < 0 || v < 0 || u >= cloud_.width || v >= cloud_.height) return nullptr;
+    const Eigen::Vector3f& q = cloud_.xyz[v * cloud_.width + u];
+    return PointCloud::IsValid(q) ? &q : nullptr;
+  }
+
+  // The paper's score, with one change for depth noise: the query point is
+  // first moved along its ray to the median depth offset of its neighbours.
+  // On a Kinect the point's own axial noise (2-4 mm) tilts every d_j the same
+  // way and lifts a flat patch's score to ~0.2-0.4, so one in ten floor
+  // points would pass t_h; the median offset is ~0 at a true edge.
+  NeighbourSum Neighbours(int u, int v, const Eigen::Vector3f& p, float radius_px) const {
+    thread_local std::vector<Eigen::Vector3f> found;
+    thread_local std::vector<float> dz;
+    found.clear();
+    const float reach2 = 2.25f * radius2_;  // 1.5 r_s: room for p's own noise
+    auto visit = [&](int du, int dv) {
+      if (du == 0 && dv == 0) return;
+      const Eigen::Vector3f* q = At(u + du, v + dv);
+      if (q == nullptr) return;
+      if ((*q - p).squaredNorm() <= reach2) found.push_back(*q);
+    };
+    if (UseFullDisc(radius_px)) {
+      const int r = static_cast<int>(std::ceil(radius_px));
+      const float r2 = radius_px * radius_px;
+      for (int dv = -r; dv <= r; ++dv) {
+        for (int du = -r; du <= r; ++du) {
+          if (du * du + dv * dv <= r2) visit(du, dv);
+        }
+      }
+    } else {
+      for (const Eigen::Vector2f& o : pattern_) {
+        visit(static_cast<int>(std::lround(o.x() * radius_px)),
+              static_cast<int>(std::lround(o.y() * radius_px)));
+      }
+    }
+    Eigen::Vector3f centre = p;
+    if (options_.denoise && found.size() >= 3) {
+      dz.clear();
+      for (const Eigen::Vector3f& q : found) dz.push_back(q.z() - p.z());
+      std::nth_element(dz.begin(), dz.begin() + dz.size() / 2, dz.end());
+      centre = p * ((p.z() + dz[dz.size() / 2]) / p.z());
+    }
+    NeighbourSum n;
+    for (const Eigen::Vector3f& q : found) {
+      const Eigen::Vector3f d = q - centre;
+      const float dist2 = d.squaredNorm();
+      if (dist2 <= radius2_) n.Add(d, dist2);
+    }
+    return n;
+  }
+
+  // True when the pixel disc of radius r around (u, v) leaves the image:
+  // the neighbourhood is cut by the frame, not by the surface.
+  bool CutByBorder(int u, int v, float radius_px) const {
+    const int r = static_cast<int>(std::ceil(radius_px));
+    return u - r < 0 || v - r < 0 || u + r >= cloud_.width || v + r >= cloud_.height;
+  }
+
+  bool OnOccludedSide(int u, int v, const Eigen::Vector3f& p, float radius_px) const {
+    const float nearer = p.z() - static_cast<float>(options_.occluded_side_jump_m);
+    for (const Eigen::Vector2f& o : pattern_) {
+      const Eigen::Vector3f* q = At(u + static_cast<int>(std::lround(o.x() * radius_px)),
+                                    v + static_cast<int>(std::lround(o.y() * radius_px)));
+      if (q != nullptr && q->z() < nearer) return true;
+    }
+    return false;
+  }
+
+  const PointCloud& cloud_;
+  const EdgePointOptions& options_;
+  const float focal_px_;
+  const float radius2_;
+  const std::vector<Eigen::Vector2f> pattern_;
+};
+
+EdgePoints Merge(const PointCloud& cloud, std::vector<Chunk>& chunks) {
+  EdgePoints out;
+  for (Chunk& c : chunks) {
+    out.indices.insert(out.indices.end(), c.indices.begin(), c.indices.end());
+    out.scores.insert(out.scores.end(), c.scores.begin(), c.scores.end());
+  }
+  out.points.reserve(out.indices.size());
+  for (int i : out.indices) out.points.push_back(cloud.xyz[i]);
+  return out;
+}
+
+EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& options,
+                           double focal_px) {
+  const OrganizedScorer scorer(cloud, options, focal_px);
+  std::vector<Chunk> chunks(options.num_threads);
+  const int step = options.coarse_step;
+  if (step <= 1) {
+    internal::ParallelForRanges(cloud.height, options.num_threads, [&](int t, int begin, int end) {
+      scorer.ScoreRows(begin, end, 1, nullptr, &chunks[t]);
+    });
+    return Merge(cloud, chunks);
+  }
+  // Coarse to fine: edge bands are several pixels wide, so a grid of one
+  // pixel in step x step finds every band; only pixels near a hit are then
+  // scored at full resolution, with the real threshold.
+  const int cells_w = (cloud.width + step - 1) / step, cells_h = (cloud.height + step - 1) / step;
+  std::vector<uint8_t> marks(static_cast<size_t>(cells_w) * cells_h, 0);
+  const float coarse_threshold =
+      static_cast<float>(options.threshold * options.coarse_threshold_factor);
+  internal::ParallelForRanges(cells_h, options.num_threads, [&](int, int begin, int end) {
+    scorer.MarkCoarse(begin, end, step, coarse_threshold, &marks);
+  });
+  internal::ParallelForRanges(cloud.height, options.num_threads, [&](int t, int begin, int end) {
+    scorer.ScoreRows(begin, end, step, &marks, &chunks[t]);
+  });
+  return Merge(cloud, chunks);
+}
+
+EdgePoints DetectUnorganized(const PointCloud& cloud, const EdgePointOptions& options) {
+  auto pcl_cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  std::vector<int> original_index;
+  pcl_cloud->reserve(cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.xyz[i];
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) continue;
+    pcl_cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    original_index.push_back(static_cast<int>(i));
+  }
+  std::vector<Chunk> chunks(options.num_threads);
+  if (pcl_cloud->empty()) return Merge(cloud, chunks);
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(pcl_cloud);
+  const int n = static_cast<int>(pcl_cloud->size());
+  internal::ParallelForRanges(n, options.num_threads, [&](int t, int begin, int end) {
+    pcl::Indices found;
+    std::vector<float> dist2;
+    for (int i = begin; i < end; ++i) {
+      const pcl::PointXYZ& q = (*pcl_cloud)[i];
+      tree.radiusSearch(q, options.radius_m, found, dist2);
+      const Eigen::Vector3f p = q.getVector3fMap();
+      NeighbourSum sum;
+      for (size_t j = 0; j < found.size(); ++j) {
+        sum.Add((*pcl_cloud)[found[j]].getVector3fMap() - p, dist2[j]);
+      }
+      if (sum.count < options.min_neighbours) continue;
+      const float score = sum.Score();
+      if (score <= options.threshold) continue;
+      chunks[t].indices.push_back(original_index[i]);
+      chunks[t].scores.push_back(score);
+    }
+  });
+  return Merge(cloud, chunks);
+}
+
+}  // namespace
+
+absl::Status EdgePointOptions::Validate() const {
+  if (!(radius_m >= 0.001 && radius_m <= 0.5)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("edge radius_m=", radius_m, " is outside [0.001, 0.5] m"));
+  }
+  if (!(threshold > 0.0 && threshold < 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("edge threshold=", threshold, " is outside (0, 1)"));
+  }
+  if (max_samples < 0 || max_samples > 4096) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("edge max_samples=", max_samples, " is outside [0, 4096]"));
+  }
+  if (min_neighbours < 1 || min_neighbours > 1000) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("edge min_neighbours=", min_neighbours, " is outside [1, 1000]"));
+  }
+  if (!(occluded_side_jump_m >= 0.0 && occluded_side_jump_m <= 1.0)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "edge occluded_side_jump_m=", occluded_side_jump_m, " is outside [0, 1] m"));
+  }
+  if (coarse_step < 1 || coarse_step > 16) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("edge coarse_step=", coarse_step, " is outside [1, 16]"));
+  }
+  if (!(coarse_threshold_factor > 0.0 && coarse_threshold_factor <= 1.0)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "edge coarse_threshold_factor=", coarse_threshold_factor, " is outside (0, 1]"));
+  }
+  if (num_threads < 1 || num_threads > 256) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("num_threads=", num_threads, " is outside [1, 256]"));
+  }
+  return absl::OkStatus();
+}
+
+float EdgeScore(const Eigen::Vector3f& p, const std::vector<Eigen::Vector3f>& neighbours) {
+  NeighbourSum sum;
+  for (const Eigen::Vector3f& n : neighbours) {
+    const Eigen::Vector3f d = n - p;
+    sum.Add(d, d.squaredNorm());
+  }
+  return sum.Score();
+}
+
+absl::StatusOr<EdgePoints> DetectEdgePoints(const PointCloud& cloud, const EdgePointOptions& options,
+                                            double focal_px) {
+  if (absl::Status s = options.Validate(); !s.ok()) return s;
+  if (absl::Status s = cloud.Validate(); !s.ok()) return s;
+  if (cloud.organized()) {
+    if (!(focal_px > 0.0 && std::isfinite(focal_px))) {
+      return absl::InvalidArgumentError(absl::StrCat("focal length ", focal_px, " px is invalid"));
+    }
+    return DetectOrganized(cloud, options, focal_px);
+  }
+  return DetectUnorganized(cloud, options);
+}
+
+}  // namespace cornerpose

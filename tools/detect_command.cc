@@ -1,0 +1,192 @@
+#include "tools/detect_command.h"
+
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "common/io/cloud_io.h"
+#include "common/perception/box_models.h"
+#include "common/perception/camera_model.h"
+#include "common/perception/detector.h"
+#include "common/viz/detection_json.h"
+#include "common/viz/detection_png.h"
+#include "common/viz/detection_ply.h"
+
+namespace cornerpose::tools {
+namespace {
+
+constexpr char kHelp[] =
+    "usage: cornerpose detect --cloud FILE --box L,B,H|NAME [outputs] [options]\n"
+    "\n"
+    "input:\n"
+    "  --cloud FILE         .pcd (ascii/binary/binary_compressed), .ply, or a 16-bit\n"
+    "                       depth .png in millimetres (needs --intrinsics)\n"
+    "  --box L,B,H|NAME     box size in metres, or brick, carton_s, carton_l,\n"
+    "                       carton_sq, carton_flat\n"
+    "  --intrinsics K       fx,fy,cx,cy or width,height,fx,fy,cx,cy: the camera of a\n"
+    "                       depth image, or of an unorganized cloud (default Kinect VGA)\n"
+    "outputs (any number):\n"
+    "  --json OUT           boxes, edges, corners and per-stage timings\n"
+    "  --ply OUT            coloured cloud: grey points, red edge points, segments,\n"
+    "                       green box wireframes, yellow corners\n"
+    "  --png OUT            depth image with the same drawn over it\n"
+    "  --edges OUT          edge points as a PCD (for tools/score.py edges)\n"
+    "detector (defaults are the paper's values):\n"
+    "  --radius M           edge neighbourhood radius r_s (0.02)\n"
+    "  --threshold T        edge score threshold t_h (0.35)\n"
+    "  --samples N          neighbours sampled per point, 0 = all (64)\n"
+    "  --ransac_threshold M RANSAC line inlier distance (0.01)\n"
+    "  --meet_distance M    corner: largest distance between two edges' lines (0.01)\n"
+    "  --threads N          worker threads (2)\n"
+    "  --quiet              print nothing but errors\n";
+
+struct Args {
+  std::map<std::string, std::string> values;
+  bool quiet = false;
+};
+
+absl::StatusOr<Args> ParseArgs(const std::vector<std::string>& args) {
+  static const char* kKnown[] = {"cloud",   "box",    "intrinsics", "json",    "ply",
+                                 "png",     "edges",  "radius",     "threshold", "samples",
+                                 "ransac_threshold", "meet_distance", "threads"};
+  Args out;
+  for (size_t i = 0; i < args.size(); ++i) {
+    std::string a = args[i];
+    if (a == "--quiet") {
+      out.quiet = true;
+      continue;
+    }
+    if (a.rfind("--", 0) != 0) return absl::InvalidArgumentError(absl::StrCat("unexpected argument '", a, "'"));
+    a = a.substr(2);
+    std::string value;
+    if (const size_t eq = a.find('='); eq != std::string::npos) {
+      value = a.substr(eq + 1);
+      a = a.substr(0, eq);
+    } else if (i + 1 < args.size()) {
+      value = args[++i];
+    } else {
+      return absl::InvalidArgumentError(absl::StrCat("option --", a, " needs a value"));
+    }
+    bool known = false;
+    for (const char* k : kKnown) known |= a == k;
+    if (!known) return absl::InvalidArgumentError(absl::StrCat("unknown option --", a));
+    out.values[a] = value;
+  }
+  return out;
+}
+
+absl::Status SetDouble(const Args& args, const std::string& key, double* out) {
+  auto it = args.values.find(key);
+  if (it == args.values.end()) return absl::OkStatus();
+  if (!absl::SimpleAtod(it->second, out)) {
+    return absl::InvalidArgumentError(absl::StrCat("--", key, " '", it->second, "' is not a number"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status SetInt(const Args& args, const std::string& key, int* out) {
+  auto it = args.values.find(key);
+  if (it == args.values.end()) return absl::OkStatus();
+  if (!absl::SimpleAtoi(it->second, out)) {
+    return absl::InvalidArgumentError(absl::StrCat("--", key, " '", it->second, "' is not an integer"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status Run(const Args& args) {
+  auto get = [&](const std::string& k) -> std::optional<std::string> {
+    auto it = args.values.find(k);
+    return it == args.values.end() ? std::nullopt : std::optional<std::string>(it->second);
+  };
+  if (!get("cloud")) return absl::InvalidArgumentError("--cloud is required");
+  if (!get("box")) return absl::InvalidArgumentError("--box is required");
+  absl::StatusOr<BoxDims> box = ParseBoxDims(*get("box"));
+  if (!box.ok()) return box.status();
+
+  DetectorOptions options;
+  options.box = *box;
+  LoadOptions load;
+  if (auto k = get("intrinsics")) {
+    absl::StatusOr<CameraIntrinsics> intrinsics = ParseIntrinsics(*k);
+    if (!intrinsics.ok()) return intrinsics.status();
+    load.intrinsics = *intrinsics;
+    options.camera = *intrinsics;
+  }
+  for (absl::Status s : {SetDouble(args, "radius", &options.edge_points.radius_m),
+                         SetDouble(args, "threshold", &options.edge_points.threshold),
+                         SetInt(args, "samples", &options.edge_points.max_samples),
+                         SetDouble(args, "ransac_threshold", &options.segments.ransac_threshold_m),
+                         SetDouble(args, "meet_distance", &options.clubbing.meet_distance_m),
+                         SetInt(args, "threads", &options.num_threads)}) {
+    if (!s.ok()) return s;
+  }
+  // r_s is also the gap at which a segment ends (Algorithm 1).
+  options.segments.gap_m = options.edge_points.radius_m;
+
+  absl::StatusOr<PointCloud> cloud = LoadPointCloud(*get("cloud"), load);
+  if (!cloud.ok()) return cloud.status();
+  absl::StatusOr<Detection> det = DetectBoxes(*cloud, options);
+  if (!det.ok()) return det.status();
+
+  if (!args.quiet) {
+    std::printf("%s: %zu points, %zu edge points, %zu segments, %zu corners, %zu boxes (%.1f ms)\n",
+                get("cloud")->c_str(), cloud->size(), det->edge_points.size(), det->segments.size(),
+                det->corners.size(), det->boxes.size(), det->timings.total_ms);
+    for (size_t i = 0; i < det->boxes.size(); ++i) {
+      const DetectedBox& b = det->boxes[i];
+      const Eigen::Vector3d t = b.camera_T_box.translation();
+      const Eigen::Vector3d ypr = b.camera_T_box.linear().eulerAngles(2, 1, 0) * 180.0 / M_PI;
+      std::printf("  box %zu: score %.2f  centre (%.3f, %.3f, %.3f) m  zyx euler (%.1f, %.1f, %.1f) deg"
+                  "  grasp %s at (%.3f, %.3f, %.3f)\n",
+                  i, b.score, t.x(), t.y(), t.z(), ypr.x(), ypr.y(), ypr.z(),
+                  BoxFaceName(b.grasp_face), b.grasp_centre_camera.x(), b.grasp_centre_camera.y(),
+                  b.grasp_centre_camera.z());
+    }
+  }
+  if (auto p = get("json")) {
+    if (absl::Status s = WriteDetectionJson(*p, *det, *box); !s.ok()) return s;
+  }
+  if (auto p = get("ply")) {
+    if (absl::Status s = WriteDetectionPly(*p, *cloud, *det, *box); !s.ok()) return s;
+  }
+  if (auto p = get("png")) {
+    CameraIntrinsics camera = options.camera.value_or(CameraIntrinsics{});
+    if (cloud->organized()) {
+      if (absl::StatusOr<CameraIntrinsics> k = EstimateIntrinsics(*cloud); k.ok()) camera = *k;
+    }
+    if (absl::Status s = WriteDetectionPng(*p, *cloud, camera, *det, *box); !s.ok()) return s;
+  }
+  if (auto p = get("edges")) {
+    if (absl::Status s = SavePoints(*p, det->edge_points); !s.ok()) return s;
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+int RunDetect(const std::vector<std::string>& argv) {
+  for (const std::string& a : argv) {
+    if (a == "--help" || a == "-h") {
+      std::fputs(kHelp, stdout);
+      return 0;
+    }
+  }
+  absl::StatusOr<Args> args = ParseArgs(argv);
+  if (!args.ok()) {
+    std::fprintf(stderr, "cornerpose detect: %s\n\n%s", std::string(args.status().message()).c_str(), kHelp);
+    return 2;
+  }
+  if (absl::Status s = Run(*args); !s.ok()) {
+    std::fprintf(stderr, "cornerpose detect: %s\n", s.ToString().c_str());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace cornerpose::tools
