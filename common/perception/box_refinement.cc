@@ -1,6 +1,7 @@
 #include "common/perception/box_refinement.h"
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -88,59 +89,65 @@ struct SideMeasure {
   bool measured() const { return kind == SideKind::kFree || kind == SideKind::kSeam; }
 };
 
-// Looks for the groove two touching boxes leave between coplanar faces
-// (rounded edges, a gap): the mean height over the plane across the side, in
-// 2 mm bins, dips at the seam. Returns the seam's position or nothing.
+// Looks for the seam two touching boxes leave between coplanar faces. A
+// wide enough gap shows as a line of missing returns (a dip in the density
+// of points on the plane); a fine one only as a shallow groove from the
+// rounded edges (a dip in their mean height). Both are measured in a window
+// sliding across the side, against flanks a few pixels away, and only within
+// seam_search_m of the hypothesised side: the Kinect's depth noise is
+// spatially correlated, and a dip searched for everywhere is often noise.
+// Returns the seam's position (outward coordinate) or nothing.
 std::optional<double> FindSeam(const std::vector<FacePoint>& pts, bool along_a, double sign,
-                               double half, double half_other, const RefinementOptions& o) {
-  constexpr double kBin = 0.002;
+                               double half, double half_other, double pixel_m,
+                               const RefinementOptions& o) {
   const double reach = o.side_band_m;
-  const int nbins = static_cast<int>(2.0 * reach / kBin);
-  std::vector<double> sum(nbins, 0.0);
-  std::vector<int> count(nbins, 0);
+  std::vector<std::pair<double, double>> rows;  // (across - half, height)
   for (const FacePoint& p : pts) {
     const double across = sign * (along_a ? p.a : p.b) - half;
     const double along = along_a ? p.b : p.a;
     if (std::abs(along) > half_other - reach || std::abs(across) >= reach) continue;
-    const int k = static_cast<int>((across + reach) / kBin);
-    sum[k] += p.n;
-    ++count[k];
+    rows.emplace_back(across, p.n);
   }
-  std::vector<double> mean(nbins, 0.0);
-  for (int k = 0; k < nbins; ++k) {
-    if (count[k] < 5) return std::nullopt;
-    mean[k] = sum[k] / count[k];
+  if (rows.size() < 50) return std::nullopt;
+  std::sort(rows.begin(), rows.end());
+  std::vector<double> xs(rows.size()), prefix(rows.size() + 1, 0.0);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    xs[i] = rows[i].first;
+    prefix[i + 1] = prefix[i] + rows[i].second;
   }
-  // Deepest 3-bin window, compared with the flanks beyond 6 mm from it.
-  int best = -1;
-  double best_depth = 0.0;
-  // Only near the hypothesised side: a dip anywhere in the band would
-  // often be noise (the Kinect's depth noise is spatially correlated).
-  const int lo = std::max(1, static_cast<int>((reach - o.seam_search_m) / kBin));
-  const int hi = std::min(nbins - 2, static_cast<int>((reach + o.seam_search_m) / kBin));
-  for (int k = lo; k <= hi; ++k) {
-    const double centre = (mean[k - 1] + mean[k] + mean[k + 1]) / 3.0;
-    double flank = 0.0;
-    int nf = 0;
-    for (int j = 0; j < nbins; ++j) {
-      if (std::abs(j - k) * kBin >= 0.006 && std::abs(j - k) * kBin <= 0.014) {
-        flank += mean[j];
-        ++nf;
-      }
+  // Count and height sum of points with across in [lo, hi).
+  auto window = [&](double lo, double hi) {
+    const size_t a = std::lower_bound(xs.begin(), xs.end(), lo) - xs.begin();
+    const size_t b = std::lower_bound(xs.begin(), xs.end(), hi) - xs.begin();
+    return std::pair<double, double>(static_cast<double>(b - a), prefix[b] - prefix[a]);
+  };
+  const double w = std::max(0.002, 1.5 * pixel_m);  // centre window width
+  const double f0 = w / 2 + pixel_m, f1 = w / 2 + 5 * pixel_m;  // flanks
+  std::optional<double> best;
+  double best_strength = 0.0;
+  for (double c = -o.seam_search_m; c <= o.seam_search_m + 1e-9; c += 0.001) {
+    const auto [nc, sc] = window(c - w / 2, c + w / 2);
+    const auto [nl, sl] = window(c - f1, c - f0);
+    const auto [nr, sr] = window(c + f0, c + f1);
+    if (nl < 10 || nr < 10) continue;
+    const double flank_density = (nl + nr) / (2.0 * (f1 - f0));
+    const double density_ratio = (nc / w) / flank_density;
+    const double groove =
+        nc >= 5 ? (sl + sr) / (nl + nr) - sc / nc : 0.0;  // how much lower the centre is
+    // Strength: how far past its threshold each test is.
+    const double strength = std::max((o.max_seam_density - density_ratio) / o.max_seam_density,
+                                     (groove - o.min_seam_depth_m) / o.min_seam_depth_m);
+    if (strength > 0.0 && strength > best_strength) {
+      best_strength = strength;
+      best = c;
     }
-    if (nf < 4) continue;
-    const double depth = flank / nf - centre;
-    if (depth > best_depth) {
-      best_depth = depth;
-      best = k;
-    }
   }
-  if (best < 0 || best_depth < o.min_seam_depth_m) return std::nullopt;
-  return half + (best + 0.5) * kBin - reach;
+  if (!best) return std::nullopt;
+  return half + *best;
 }
 
 SideMeasure MeasureSide(const std::vector<FacePoint>& pts, bool along_a, double sign, double half,
-                        double half_other, const RefinementOptions& o) {
+                        double half_other, double pixel_m, const RefinementOptions& o) {
   const double band = o.side_band_m;
   int inner = 0, outer = 0;
   const double bin = 0.01;
@@ -162,7 +169,7 @@ SideMeasure MeasureSide(const std::vector<FacePoint>& pts, bool along_a, double 
   if (outer > o.free_side_ratio * inner) {
     // The face continues past the side: a seam to a touching box, or the
     // hypothesis is too small for this face.
-    if (std::optional<double> seam = FindSeam(pts, along_a, sign, half, half_other, o)) {
+    if (std::optional<double> seam = FindSeam(pts, along_a, sign, half, half_other, pixel_m, o)) {
       m.kind = SideKind::kSeam;
       m.position = *seam;
     } else {
@@ -217,6 +224,7 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
     const std::vector<FacePoint> pts =
         CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m);
+    const double pixel_m = f.c.z() / depth.camera.fx;  // point spacing on the face
     // Plane through the interior points.
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     int n = 0;
@@ -240,10 +248,10 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     result.face_points = n;
 
     // Sides: +a, -a, +b, -b.
-    const SideMeasure pa = MeasureSide(pts, true, 1.0, f.half_a, f.half_b, options);
-    const SideMeasure ma = MeasureSide(pts, true, -1.0, f.half_a, f.half_b, options);
-    const SideMeasure pb = MeasureSide(pts, false, 1.0, f.half_b, f.half_a, options);
-    const SideMeasure mb = MeasureSide(pts, false, -1.0, f.half_b, f.half_a, options);
+    const SideMeasure pa = MeasureSide(pts, true, 1.0, f.half_a, f.half_b, pixel_m, options);
+    const SideMeasure ma = MeasureSide(pts, true, -1.0, f.half_a, f.half_b, pixel_m, options);
+    const SideMeasure pb = MeasureSide(pts, false, 1.0, f.half_b, f.half_a, pixel_m, options);
+    const SideMeasure mb = MeasureSide(pts, false, -1.0, f.half_b, f.half_a, pixel_m, options);
     result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
     result.free_sides = 0;
     for (SideKind k : result.sides) result.free_sides += k == SideKind::kFree;

@@ -24,9 +24,12 @@ struct RefinementOptions {
   // share of its inner band. Unitless.
   double free_side_ratio = 0.15;
   // Least depth of the groove between two touching coplanar faces. Metres.
-  // Fine seams (gaps under ~2 mm) are too shallow to tell from the depth
-  // noise; they are left to other evidence rather than guessed.
+  // A seam is a groove at least this deep (metres) or a line where the
+  // density of points on the plane falls below this share of its flanks'.
+  // Fine seams (gaps under ~1 mm) can show neither; the side then counts as
+  // continuing and the box is not returned rather than guessed.
   double min_seam_depth_m = 0.0015;
+  double max_seam_density = 0.55;
   // The groove is looked for this far either side of the hypothesised side.
   // Metres.
   double seam_search_m = 0.006;

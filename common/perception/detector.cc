@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "common/perception/camera_model.h"
 #include "common/perception/internal/box_overlap.h"
+#include "common/perception/neighbour_hypotheses.h"
+#include "common/perception/pose_error.h"
 
 namespace cornerpose {
 namespace {
@@ -54,6 +57,89 @@ double Judge(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& 
                         0.25 * grasp_occluded,
                     0.0, 1.0);
 }
+
+// Checks pose hypotheses against the depth image: a cheap render-and-compare
+// first, then refinement on the grasp face and the full judgement. Poses it
+// has already seen (same place, same orientation up to the box's symmetries)
+// are skipped, since corners of one box propose it many times.
+class HypothesisJudge {
+ public:
+  HypothesisJudge(const DepthImage& depth, const DetectorOptions& options)
+      : depth_(depth), options_(options), symmetries_(BoxSymmetries(options.box)) {}
+
+  void Consider(const Eigen::Isometry3d& pose_in, int corners, std::vector<int> segments) {
+    if (Seen(pose_in)) return;
+    seen_.push_back(pose_in);
+    Candidate cand;
+    cand.box.camera_T_box = pose_in;
+    cand.box.num_corners = corners;
+    cand.box.segments = std::move(segments);
+    const BoxEvidence first = MeasureBox(depth_, pose_in, options_.box, options_.evidence);
+    if (!first.in_front_of_camera || first.see_through_fraction() > 0.3 || first.support() < 0.3) {
+      return;
+    }
+    const BoxFace grasp = first.grasp_face;
+    if (!GraspFaceInView(pose_in, grasp)) return;
+    cand.refinement = RefineOnGraspFace(depth_, options_.box, grasp, options_.refinement,
+                                        &cand.box.camera_T_box);
+    cand.evidence = MeasureBox(depth_, cand.box.camera_T_box, options_.box, options_.evidence);
+    const double score =
+        Judge(cand.evidence, cand.refinement, options_.box, grasp, options_.acceptance);
+    if (score < 0.0 || !GraspFaceInView(cand.box.camera_T_box, grasp)) return;
+    cand.box.score = score;
+    cand.box.grasp_face = cand.evidence.grasp_face;
+    const Eigen::Vector3d n_box = BoxFaceNormal(cand.box.grasp_face);
+    const int axis = static_cast<int>(cand.box.grasp_face) / 2;
+    cand.box.grasp_normal_camera = cand.box.camera_T_box.linear() * n_box;
+    cand.box.grasp_centre_camera = cand.box.camera_T_box * (n_box * options_.box[axis] / 2.0);
+    accepted_.push_back(std::move(cand));
+  }
+
+  std::vector<Candidate> TakeAccepted() { return std::exchange(accepted_, {}); }
+
+ private:
+  // A face cut by the image border cannot be checked to its end (and a
+  // gripper aimed at its centre may miss the box): such boxes are not
+  // returned.
+  bool GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face) const {
+    const int f = static_cast<int>(face);
+    const int n = f / 2, a = (n + 1) % 3, b = (n + 2) % 3;
+    const double margin = options_.acceptance.border_margin_px;
+    const CameraIntrinsics& k = depth_.camera;
+    for (double sa : {-0.5, 0.5}) {
+      for (double sb : {-0.5, 0.5}) {
+        Eigen::Vector3d local = Eigen::Vector3d::Zero();
+        local[n] = (f % 2 == 0 ? 0.5 : -0.5) * options_.box[n];
+        local[a] = sa * options_.box[a];
+        local[b] = sb * options_.box[b];
+        const Eigen::Vector3d p = pose * local;
+        if (p.z() <= 0.05) return false;
+        const Eigen::Vector2d px = Project(k, p);
+        if (px.x() < margin || px.y() < margin || px.x() > k.width - 1 - margin ||
+            px.y() > k.height - 1 - margin) {
+          return false;
+        }
+      }
+    }
+    return true;
+  }
+
+  bool Seen(const Eigen::Isometry3d& pose) const {
+    for (const Eigen::Isometry3d& s : seen_) {
+      if ((s.translation() - pose.translation()).norm() > 0.01) continue;
+      for (const Eigen::Matrix3d& S : symmetries_) {
+        if ((s.linear() - pose.linear() * S).norm() < 0.06) return true;  // ~2.5 degrees
+      }
+    }
+    return false;
+  }
+
+  const DepthImage& depth_;
+  const DetectorOptions& options_;
+  const std::vector<Eigen::Matrix3d> symmetries_;
+  std::vector<Eigen::Isometry3d> seen_;
+  std::vector<Candidate> accepted_;
+};
 
 }  // namespace
 
@@ -142,7 +228,7 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& cloud, const DetectorOpt
     group_corners[group_of[c.segment_a]].push_back(c.position.cast<double>());
   }
 
-  std::vector<Candidate> candidates;
+  HypothesisJudge judge(depth, options);
   for (const Corner& c : det.corners) {
     const EdgeSegment& sa = det.segments[c.segment_a];
     const EdgeSegment& sb = det.segments[c.segment_b];
@@ -152,50 +238,42 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& cloud, const DetectorOpt
     const double la = (fa - p1).norm(), lb = (fb - p1).norm();
     if (la < 1e-3 || lb < 1e-3) continue;
     for (const AxisAssignment& as : MatchEdgeLengths(la, lb, options.box, options.pose)) {
-      Candidate cand;
-      cand.box.camera_T_box = PoseFromCorner(p1, fa - p1, fb - p1, as, options.box);
-      cand.box.num_corners =
-          1 + RefineWithCorners(group_corners[group_of[c.segment_a]], options.box, options.pose,
-                                &cand.box.camera_T_box);
-      cand.box.segments = {c.segment_a, c.segment_b};
-      // Cheap rejection before refinement.
-      BoxEvidence first = MeasureBox(depth, cand.box.camera_T_box, options.box, options.evidence);
-      if (!first.in_front_of_camera || first.see_through_fraction() > 0.3 ||
-          first.support() < 0.3) {
-        continue;
-      }
-      const BoxFace grasp = first.grasp_face;
-      cand.refinement =
-          RefineOnGraspFace(depth, options.box, grasp, options.refinement, &cand.box.camera_T_box);
-      cand.evidence = MeasureBox(depth, cand.box.camera_T_box, options.box, options.evidence);
-      const double score = Judge(cand.evidence, cand.refinement, options.box, grasp,
-                                 options.acceptance);
-      if (score < 0.0) continue;
-      cand.box.score = score;
-      cand.box.grasp_face = cand.evidence.grasp_face;
-      const Eigen::Vector3d n_box = BoxFaceNormal(cand.box.grasp_face);
-      const int axis = static_cast<int>(cand.box.grasp_face) / 2;
-      cand.box.grasp_normal_camera = cand.box.camera_T_box.linear() * n_box;
-      cand.box.grasp_centre_camera =
-          cand.box.camera_T_box * (n_box * options.box[axis] / 2.0);
-      candidates.push_back(std::move(cand));
+      Eigen::Isometry3d pose = PoseFromCorner(p1, fa - p1, fb - p1, as, options.box);
+      const int corners = 1 + RefineWithCorners(group_corners[group_of[c.segment_a]], options.box,
+                                                options.pose, &pose);
+      judge.Consider(pose, corners, {c.segment_a, c.segment_b});
     }
   }
   // Best first; a box overlapping an accepted one is the same box or a
-  // contradiction, and is dropped.
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.box.score > b.box.score; });
-  for (Candidate& c : candidates) {
-    bool clash = false;
-    for (const DetectedBox& kept : det.boxes) {
-      if (internal::BoxesOverlap(kept.camera_T_box, c.box.camera_T_box, options.box,
-                                 options.acceptance.overlap_margin_m)) {
-        clash = true;
-        break;
+  // contradiction, and is dropped. Each accepted box proposes its
+  // neighbours, which are judged the same way and may propose theirs.
+  std::vector<Candidate> pending = judge.TakeAccepted();
+  while (!pending.empty()) {
+    std::stable_sort(pending.begin(), pending.end(), [](const Candidate& a, const Candidate& b) {
+      return a.box.score > b.box.score;
+    });
+    for (Candidate& c : pending) {
+      bool clash = false;
+      for (const DetectedBox& kept : det.boxes) {
+        if (internal::BoxesOverlap(kept.camera_T_box, c.box.camera_T_box, options.box,
+                                   options.acceptance.overlap_margin_m)) {
+          clash = true;
+          break;
+        }
+      }
+      if (clash) continue;
+      det.boxes.push_back(c.box);
+      if (options.propagate_to_neighbours) {
+        for (const Eigen::Isometry3d& pose :
+             NeighbourHypotheses(c.box, options.box, options.neighbour_gap_m)) {
+          judge.Consider(pose, 0, {});
+        }
       }
     }
-    if (!clash) det.boxes.push_back(std::move(c.box));
+    pending = judge.TakeAccepted();
   }
+  std::stable_sort(det.boxes.begin(), det.boxes.end(),
+                   [](const DetectedBox& a, const DetectedBox& b) { return a.score > b.score; });
   det.timings.poses_ms = MsSince(t0);
   det.timings.total_ms = MsSince(t_start);
   return det;

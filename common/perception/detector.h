@@ -32,6 +32,8 @@ struct AcceptanceOptions {
   // A face measured between two free sides must match its known size within
   // this. Metres.
   double extent_tolerance_m = 0.025;
+  // The grasp face must project this far inside the image. Pixels.
+  double border_margin_px = 3.0;
   // Two accepted boxes may not overlap by more than this (each is shrunk by
   // it before the overlap test). Metres.
   double overlap_margin_m = 0.015;
@@ -51,6 +53,10 @@ struct DetectorOptions {
   // The camera of an unorganized cloud, used to render hypotheses; organized
   // clouds carry their own (recovered from the points). Default: Kinect VGA.
   std::optional<CameraIntrinsics> camera;
+  // Each confirmed box proposes the boxes that would touch it side by side
+  // (pallet layers, where seams leave few edges), neighbour_gap_m apart.
+  bool propagate_to_neighbours = true;
+  double neighbour_gap_m = 0.002;
   // Worker threads (edge points). Count.
   int num_threads = 2;
   // Frames above this many points are refused. Count.
