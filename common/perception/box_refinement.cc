@@ -49,8 +49,9 @@ FaceFrame MakeFaceFrame(const Eigen::Isometry3d& camera_T_box, const BoxDims& di
 }
 
 // Measured points near the face, in face coordinates.
+// Points in front of the plane (an occluder) go to `front` when given.
 std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margin,
-                                         double plane_tol) {
+                                         double plane_tol, std::vector<FacePoint>* front) {
   const CameraIntrinsics& k = depth.camera;
   double u0 = std::numeric_limits<double>::max(), v0 = u0, u1 = -u0, v1 = -u0;
   for (double sa : {-1.0, 1.0}) {
@@ -73,8 +74,12 @@ std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFram
       if (std::isnan(z)) continue;
       const Eigen::Vector3d d = z * PixelRay(k, u, v) - f.c;
       const FacePoint q{d.dot(f.a), d.dot(f.b), d.dot(f.n)};
-      if (std::abs(q.n) > plane_tol) continue;
       if (std::abs(q.a) > f.half_a + margin || std::abs(q.b) > f.half_b + margin) continue;
+      if (q.n > plane_tol) {
+        if (front != nullptr) front->push_back(q);
+        continue;
+      }
+      if (q.n < -plane_tol) continue;
       pts.push_back(q);
     }
   }
@@ -146,8 +151,9 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts, bool along_a, 
   return half + *best;
 }
 
-SideMeasure MeasureSide(const std::vector<FacePoint>& pts, bool along_a, double sign, double half,
-                        double half_other, double pixel_m, const RefinementOptions& o) {
+SideMeasure MeasureSide(const std::vector<FacePoint>& pts, const std::vector<FacePoint>& front,
+                        bool along_a, double sign, double half, double half_other, double pixel_m,
+                        const RefinementOptions& o) {
   const double band = o.side_band_m;
   int inner = 0, outer = 0;
   const double bin = 0.01;
@@ -166,6 +172,18 @@ SideMeasure MeasureSide(const std::vector<FacePoint>& pts, bool along_a, double 
   }
   SideMeasure m;
   if (inner < 10) return m;  // hidden or cut: no say
+  // Something in front of the plane just past the side: the face may go on
+  // underneath it, so the side is not where the face ends.
+  int in_front = 0;
+  for (const FacePoint& p : front) {
+    const double across = sign * (along_a ? p.a : p.b);
+    const double along = along_a ? p.b : p.a;
+    in_front += std::abs(along) <= half_other - band && across > half + 0.005 && across <= half + band;
+  }
+  if (in_front > o.free_side_ratio * inner && in_front > outer) {
+    m.kind = SideKind::kOccluded;
+    return m;
+  }
   if (outer > o.free_side_ratio * inner) {
     // The face continues past the side: a seam to a touching box, or the
     // hypothesis is too small for this face.
@@ -199,6 +217,65 @@ SideMeasure MeasureSide(const std::vector<FacePoint>& pts, bool along_a, double 
   return m;
 }
 
+// Where the face's plane ends beyond one side: marches outward from the
+// side along `dir` on the plane, reading the depth image, until the measured
+// surface leaves the plane for good. Returns the distance from the side to
+// that end (metres), or nothing when the march leaves the image first.
+std::optional<double> DistanceToPlaneEnd(const DepthImage& depth, const Eigen::Vector3d& start,
+                                         const Eigen::Vector3d& dir, const Eigen::Vector3d& normal,
+                                         const RefinementOptions& o) {
+  constexpr double kStep = 0.004;
+  constexpr int kOffPlaneToEnd = 4;  // consecutive samples off the plane (1.6 cm)
+  int off = 0;
+  for (double d = kStep; d < o.max_tile_march_m; d += kStep) {
+    const Eigen::Vector3d q = start + d * dir;
+    if (q.z() <= 0.05) return std::nullopt;
+    const Eigen::Vector2d px = Project(depth.camera, q);
+    const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+    if (!depth.inside(u, v)) return std::nullopt;
+    const float z = depth.at(u, v);
+    bool on_plane = false;
+    if (!std::isnan(z)) {
+      const Eigen::Vector3d m = z * PixelRay(depth.camera, u, v);
+      const double height = (m - q).dot(normal);
+      // Something in front hides where the plane ends.
+      if (height > o.plane_tolerance_m) return std::nullopt;
+      on_plane = std::abs(height) < o.plane_tolerance_m;
+    }
+    off = on_plane ? 0 : off + 1;
+    if (off == kOffPlaneToEnd) return d - (kOffPlaneToEnd - 0.5) * kStep;
+  }
+  return std::nullopt;
+}
+
+// Distance from a side to where the face's plane ends beyond it, the
+// smallest over three lines across the side (a layer can be notched where
+// boxes were taken); nothing when any march leaves the image.
+std::optional<double> LayerRunBeyond(const DepthImage& depth, const Eigen::Vector3d& side_centre,
+                                     const Eigen::Vector3d& across, const Eigen::Vector3d& along,
+                                     double half_along, const Eigen::Vector3d& normal,
+                                     const RefinementOptions& o) {
+  std::optional<double> shortest;
+  for (double t : {-0.6, 0.0, 0.6}) {
+    const std::optional<double> d =
+        DistanceToPlaneEnd(depth, side_centre + t * half_along * along, across, normal, o);
+    if (!d) return std::nullopt;
+    shortest = shortest ? std::min(*shortest, *d) : *d;
+  }
+  return shortest;
+}
+
+// How many tiles of size `tile`, laid with gaps of 0 to 2 tile_gap_m, make
+// a run of `extent` metres (within tile_tolerance_m); 0 when none do.
+int TileCount(double extent, double tile, const RefinementOptions& o) {
+  const int k = static_cast<int>(std::lround(extent / (tile + o.tile_gap_m)));
+  if (k < 1) return 0;
+  const double slack = extent - k * tile;  // room left for k - 1 gaps
+  const bool fits = slack >= -o.tile_tolerance_m &&
+                    slack <= (k - 1) * 2.0 * o.tile_gap_m + o.tile_tolerance_m;
+  return fits ? k : 0;
+}
+
 }  // namespace
 
 absl::Status RefinementOptions::Validate() const {
@@ -222,8 +299,9 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
   Eigen::Isometry3d pose = initial;
   for (int it = 0; it < std::max(1, options.iterations); ++it) {
     FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
+    std::vector<FacePoint> front;
     const std::vector<FacePoint> pts =
-        CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m);
+        CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m, &front);
     const double pixel_m = f.c.z() / depth.camera.fx;  // point spacing on the face
     // Plane through the interior points.
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -248,10 +326,10 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     result.face_points = n;
 
     // Sides: +a, -a, +b, -b.
-    const SideMeasure pa = MeasureSide(pts, true, 1.0, f.half_a, f.half_b, pixel_m, options);
-    const SideMeasure ma = MeasureSide(pts, true, -1.0, f.half_a, f.half_b, pixel_m, options);
-    const SideMeasure pb = MeasureSide(pts, false, 1.0, f.half_b, f.half_a, pixel_m, options);
-    const SideMeasure mb = MeasureSide(pts, false, -1.0, f.half_b, f.half_a, pixel_m, options);
+    const SideMeasure pa = MeasureSide(pts, front, true, 1.0, f.half_a, f.half_b, pixel_m, options);
+    const SideMeasure ma = MeasureSide(pts, front, true, -1.0, f.half_a, f.half_b, pixel_m, options);
+    const SideMeasure pb = MeasureSide(pts, front, false, 1.0, f.half_b, f.half_a, pixel_m, options);
+    const SideMeasure mb = MeasureSide(pts, front, false, -1.0, f.half_b, f.half_a, pixel_m, options);
     result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
     result.free_sides = 0;
     for (SideKind k : result.sides) result.free_sides += k == SideKind::kFree;
@@ -291,6 +369,56 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     R.col(f.axis_b) = b_cam;
     pose.linear() = R;
     pose.translation() = centre - n_cam * dims[f.axis_n] / 2.0;
+  }
+  // Sides where the face runs on without a visible seam (pallet layers with
+  // fine gaps): the face may be one tile of a layer of touching boxes, or a
+  // part of a bigger face. The coplanar run through the box is measured to
+  // the layer's ends along both of the face's axes; the hypothesis must
+  // tile it with whole boxes, and with fewer boxes (fewer unseen seams) than
+  // any other pair of the box's sides does. A top face twice a side's width
+  // is then one face, not two; a pallet layer of 4 x 4 cartons is not read
+  // as 8 x 4 cartons on their sides. Its continuing sides count as kTiled.
+  const bool runs_on = std::any_of(result.sides.begin(), result.sides.end(),
+                                   [](SideKind k) { return k == SideKind::kContinues; });
+  if (runs_on && options.max_tile_march_m > 0.0) {
+    const FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
+    const Eigen::Vector3d axis_dir[2] = {f.a, f.b};
+    const double size[2] = {2 * f.half_a, 2 * f.half_b};
+    double extent[2] = {size[0], size[1]};
+    bool measured = true;
+    for (int ax = 0; ax < 2 && measured; ++ax) {
+      for (int sgn = 0; sgn < 2 && measured; ++sgn) {
+        if (result.sides[2 * ax + sgn] != SideKind::kContinues) continue;
+        const Eigen::Vector3d across = sgn == 0 ? axis_dir[ax] : -axis_dir[ax];
+        const std::optional<double> run =
+            LayerRunBeyond(depth, f.c + 0.5 * size[ax] * across, across, axis_dir[1 - ax],
+                           0.5 * size[1 - ax], f.n, options);
+        if (run) {
+          extent[ax] += *run + options.tile_gap_m;
+        } else {
+          measured = false;
+        }
+      }
+    }
+    const int tiles = measured ? TileCount(extent[0], size[0], options) *
+                                     TileCount(extent[1], size[1], options)
+                               : 0;
+    bool fewest = tiles > 0;
+    for (int i = 0; i < 3 && fewest; ++i) {
+      for (int j = 0; j < 3 && fewest; ++j) {
+        if (i == j || (std::abs(dims[i] - size[0]) < 1e-6 && std::abs(dims[j] - size[1]) < 1e-6)) {
+          continue;
+        }
+        const int other = TileCount(extent[0], dims[i], options) *
+                          TileCount(extent[1], dims[j], options);
+        if (other > 0 && other <= tiles) fewest = false;
+      }
+    }
+    if (fewest) {
+      for (SideKind& k : result.sides) {
+        if (k == SideKind::kContinues) k = SideKind::kTiled;
+      }
+    }
   }
   const double shift = (pose.translation() - initial.translation()).norm();
   const double turn_deg =

@@ -29,10 +29,16 @@ struct RefinementOptions {
   // Fine seams (gaps under ~1 mm) can show neither; the side then counts as
   // continuing and the box is not returned rather than guessed.
   double min_seam_depth_m = 0.0015;
-  double max_seam_density = 0.55;
+  double max_seam_density = 0.7;
   // The groove is looked for this far either side of the hypothesised side.
   // Metres.
   double seam_search_m = 0.006;
+  // A face that runs on past a side is one tile of a layer when the layer
+  // ends a whole number of (box size + tile_gap_m) away, within
+  // tile_tolerance_m, searched up to max_tile_march_m (0 disables). Metres.
+  double tile_gap_m = 0.002;
+  double tile_tolerance_m = 0.01;
+  double max_tile_march_m = 2.5;
   // Iterations of measure-and-update. Count.
   int iterations = 3;
   // Largest correction accepted, beyond which the hypothesis is not this
@@ -48,6 +54,8 @@ enum class SideKind : uint8_t {
   kUnknown,    // too few points near the side (hidden or out of view)
   kFree,       // the face ends: a depth jump, a crease or no return
   kSeam,       // a coplanar face continues past a groove: a touching box
+  kOccluded,   // something lies in front just past the side: the face may go on
+  kTiled,      // the face goes on, flat, and ends a whole number of boxes away
   kContinues,  // the face goes on, flat: the box is not this size here
 };
 

@@ -50,9 +50,22 @@ double Judge(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& 
   int measured = 0;
   for (SideKind k : ref.sides) {
     if (k == SideKind::kContinues) return -1.0;
-    measured += k == SideKind::kFree || k == SideKind::kSeam;
+    measured += k == SideKind::kFree || k == SideKind::kSeam || k == SideKind::kTiled;
   }
   if (ref.free_sides < 1 || measured < 2) return -1.0;
+  // A side hidden under something may hide more face: keep the box only if
+  // no bigger side of the box could stand in for this one there.
+  for (int s = 0; s < 4; ++s) {
+    if (ref.sides[s] != SideKind::kOccluded) continue;
+    const int here = s < 2 ? axis_a : axis_b, other = s < 2 ? axis_b : axis_a;
+    for (int k = 0; k < 3; ++k) {
+      if (k != here && k != other && dims[k] > dims[here] + o.extent_tolerance_m) return -1.0;
+      if (k == other && dims[k] > dims[here] + o.extent_tolerance_m &&
+          ref.sides[s < 2 ? 2 : 0] == SideKind::kOccluded) {
+        return -1.0;
+      }
+    }
+  }
   return std::clamp(0.5 * grasp_support + 0.5 * ev.support() - 2.0 * ev.see_through_fraction() -
                         0.25 * grasp_occluded,
                     0.0, 1.0);
