@@ -52,7 +52,9 @@ double Judge(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& 
     if (k == SideKind::kContinues) return -1.0;
     measured += k == SideKind::kFree || k == SideKind::kSeam || k == SideKind::kTiled;
   }
-  if (ref.free_sides < 1 || measured < 2) return -1.0;
+  // At least two sides pin the face down; a face with no free side must be
+  // boxed in on all four (by seams or whole tiles of its layer).
+  if (measured < 2 || (ref.free_sides < 1 && measured < 4)) return -1.0;
   // A side hidden under something may hide more face: keep the box only if
   // no bigger side of the box could stand in for this one there.
   for (int s = 0; s < 4; ++s) {
