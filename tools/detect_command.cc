@@ -44,11 +44,14 @@ constexpr char kHelp[] =
     "  --ransac_threshold M RANSAC line inlier distance (0.01)\n"
     "  --meet_distance M    corner: largest distance between two edges' lines (0.01)\n"
     "  --threads N          worker threads (2)\n"
+    "  --kdtree             unorganized clouds: score edges over a k-d tree (the\n"
+    "                       paper's way) instead of projecting onto the camera grid\n"
     "  --quiet              print nothing but errors\n";
 
 struct Args {
   std::map<std::string, std::string> values;
   bool quiet = false;
+  bool kdtree = false;
 };
 
 absl::StatusOr<Args> ParseArgs(const std::vector<std::string>& args) {
@@ -60,6 +63,10 @@ absl::StatusOr<Args> ParseArgs(const std::vector<std::string>& args) {
     std::string a = args[i];
     if (a == "--quiet") {
       out.quiet = true;
+      continue;
+    }
+    if (a == "--kdtree") {
+      out.kdtree = true;
       continue;
     }
     if (a.rfind("--", 0) != 0) return absl::InvalidArgumentError(absl::StrCat("unexpected argument '", a, "'"));
@@ -126,6 +133,7 @@ absl::Status Run(const Args& args) {
                          SetInt(args, "threads", &options.num_threads)}) {
     if (!s.ok()) return s;
   }
+  options.project_unorganized = !args.kdtree;
   // r_s is also the gap at which a segment ends (Algorithm 1).
   options.segments.gap_m = options.edge_points.radius_m;
 

@@ -211,11 +211,17 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& cloud, const DetectorOpt
     }
     camera = *k;
   }
-  const DepthImage depth = MakeDepthImage(cloud, camera);
+  // A single-view unorganized cloud is laid back onto the camera's pixel
+  // grid, so it takes the same (fast, shadow-aware) path as a frame.
+  PointCloud projected;
+  const bool project = !cloud.organized() && options.project_unorganized;
+  if (project) projected = OrganizeByProjection(cloud, camera);
+  const PointCloud& work = project ? projected : cloud;
+  const DepthImage depth = MakeDepthImage(work, camera);
   det.timings.preprocess_ms = MsSince(t_start);
 
   Clock::time_point t0 = Clock::now();
-  absl::StatusOr<EdgePoints> edges = DetectEdgePoints(cloud, options.edge_points, camera.fx);
+  absl::StatusOr<EdgePoints> edges = DetectEdgePoints(work, options.edge_points, camera.fx);
   if (!edges.ok()) return edges.status();
   det.edge_points = edges->points;
   det.timings.edge_points_ms = MsSince(t0);

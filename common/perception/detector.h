@@ -57,6 +57,11 @@ struct DetectorOptions {
   // (pallet layers, where seams leave few edges), neighbour_gap_m apart.
   bool propagate_to_neighbours = true;
   double neighbour_gap_m = 0.002;
+  // Unorganized clouds are projected through `camera` onto its pixel grid
+  // (the nearest point per pixel) and processed like a frame. Right for a
+  // cloud from one depth camera, in its frame; for merged or foreign clouds
+  // set it false to score edges over a k-d tree as the paper does.
+  bool project_unorganized = true;
   // Worker threads (edge points). Count.
   int num_threads = 2;
   // Frames above this many points are refused. Count.

@@ -249,14 +249,25 @@ EdgePoints DetectUnorganized(const PointCloud& cloud, const EdgePointOptions& op
   const int n = static_cast<int>(pcl_cloud->size());
   internal::ParallelForRanges(n, options.num_threads, [&](int t, int begin, int end) {
     pcl::Indices found;
-    std::vector<float> dist2;
+    std::vector<float> dist2, dz;
+    const float r2 = static_cast<float>(options.radius_m * options.radius_m);
     for (int i = begin; i < end; ++i) {
       const pcl::PointXYZ& q = (*pcl_cloud)[i];
       tree.radiusSearch(q, options.radius_m, found, dist2);
-      const Eigen::Vector3f p = q.getVector3fMap();
+      Eigen::Vector3f p = q.getVector3fMap();
+      if (options.denoise && found.size() >= 3 && p.z() > 0.0f) {
+        // As on organized frames: score from the neighbours' median depth,
+        // moving p along its ray from the camera at the origin.
+        dz.clear();
+        for (const auto j : found) dz.push_back((*pcl_cloud)[j].z - p.z());
+        std::nth_element(dz.begin(), dz.begin() + dz.size() / 2, dz.end());
+        p *= (p.z() + dz[dz.size() / 2]) / p.z();
+      }
       NeighbourSum sum;
-      for (size_t j = 0; j < found.size(); ++j) {
-        sum.Add((*pcl_cloud)[found[j]].getVector3fMap() - p, dist2[j]);
+      for (const auto j : found) {
+        const Eigen::Vector3f d = (*pcl_cloud)[j].getVector3fMap() - p;
+        const float d2 = d.squaredNorm();
+        if (d2 <= r2) sum.Add(d, d2);
       }
       if (sum.count < options.min_neighbours) continue;
       const float score = sum.Score();

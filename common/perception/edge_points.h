@@ -30,9 +30,9 @@ struct EdgePointOptions {
   // which scores as a boundary but is no edge of the surface it lies on.
   // Metres; 0 disables.
   double occluded_side_jump_m = 0.03;
-  // Organized frames only: score each point from the median depth of its
-  // neighbours rather than its own noisy depth (see edge_points.cc). Off
-  // gives the paper's formula exactly.
+  // Score each point from the median depth of its neighbours rather than
+  // its own noisy depth (see edge_points.cc); assumes a cloud in the frame of
+  // the camera that took it. Off gives the paper's formula exactly.
   bool denoise = true;
   // Organized frames only: score one pixel in coarse_step x coarse_step
   // first, then every pixel next to a coarse hit; 1 scores every pixel (the
