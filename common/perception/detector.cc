@@ -85,22 +85,34 @@ class HypothesisJudge {
   void Consider(const Eigen::Isometry3d& pose_in, int corners, std::vector<int> segments) {
     if (Seen(pose_in)) return;
     seen_.push_back(pose_in);
+    ++stats_.proposed;
     Candidate cand;
     cand.box.camera_T_box = pose_in;
     cand.box.num_corners = corners;
     cand.box.segments = std::move(segments);
     const BoxEvidence first = MeasureBox(depth_, pose_in, options_.box, options_.evidence);
-    if (!first.in_front_of_camera || first.see_through_fraction() > 0.3 || first.support() < 0.3) {
+    // Refinement moves a hypothesis by centimetres at most: one that the
+    // depth image already rejects by a wide margin is not worth refining.
+    const BoxFace grasp = first.grasp_face;
+    const FaceEvidence& g = first.faces[static_cast<int>(grasp)];
+    if (!first.in_front_of_camera || first.see_through_fraction() > 0.2 ||
+        first.support() < 0.4 || g.visible() <= 0 ||
+        static_cast<double>(g.agree) / g.visible() < 0.5) {
       return;
     }
-    const BoxFace grasp = first.grasp_face;
-    if (!GraspFaceInView(pose_in, grasp)) return;
+    // Unrefined corners can be a centimetre off: only the refined face must
+    // lie inside the image (checked below).
+    if (!GraspFaceInView(pose_in, grasp, -20.0)) return;
+    ++stats_.refined;
     cand.refinement = RefineOnGraspFace(depth_, options_.box, grasp, options_.refinement,
                                         &cand.box.camera_T_box);
     cand.evidence = MeasureBox(depth_, cand.box.camera_T_box, options_.box, options_.evidence);
     const double score =
         Judge(cand.evidence, cand.refinement, options_.box, grasp, options_.acceptance);
-    if (score < 0.0 || !GraspFaceInView(cand.box.camera_T_box, grasp)) return;
+    if (score < 0.0 ||
+        !GraspFaceInView(cand.box.camera_T_box, grasp, options_.acceptance.border_margin_px)) {
+      return;
+    }
     cand.box.score = score;
     cand.box.grasp_face = cand.evidence.grasp_face;
     const Eigen::Vector3d n_box = BoxFaceNormal(cand.box.grasp_face);
@@ -108,7 +120,10 @@ class HypothesisJudge {
     cand.box.grasp_normal_camera = cand.box.camera_T_box.linear() * n_box;
     cand.box.grasp_centre_camera = cand.box.camera_T_box * (n_box * options_.box[axis] / 2.0);
     accepted_.push_back(std::move(cand));
+    ++stats_.accepted;
   }
+
+  const HypothesisStats& stats() const { return stats_; }
 
   std::vector<Candidate> TakeAccepted() { return std::exchange(accepted_, {}); }
 
@@ -116,10 +131,9 @@ class HypothesisJudge {
   // A face cut by the image border cannot be checked to its end (and a
   // gripper aimed at its centre may miss the box): such boxes are not
   // returned.
-  bool GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face) const {
+  bool GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face, double margin) const {
     const int f = static_cast<int>(face);
     const int n = f / 2, a = (n + 1) % 3, b = (n + 2) % 3;
-    const double margin = options_.acceptance.border_margin_px;
     const CameraIntrinsics& k = depth_.camera;
     for (double sa : {-0.5, 0.5}) {
       for (double sb : {-0.5, 0.5}) {
@@ -154,6 +168,7 @@ class HypothesisJudge {
   const std::vector<Eigen::Matrix3d> symmetries_;
   std::vector<Eigen::Isometry3d> seen_;
   std::vector<Candidate> accepted_;
+  HypothesisStats stats_;
 };
 
 }  // namespace
@@ -295,6 +310,7 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& cloud, const DetectorOpt
   }
   std::stable_sort(det.boxes.begin(), det.boxes.end(),
                    [](const DetectedBox& a, const DetectedBox& b) { return a.score > b.score; });
+  det.hypotheses = judge.stats();
   det.timings.poses_ms = MsSince(t0);
   det.timings.total_ms = MsSince(t_start);
   return det;

@@ -107,6 +107,14 @@ struct StageTimings {
   double total_ms = 0.0;
 };
 
+// How much work the pose stage did: hypotheses proposed (corners and
+// neighbours), refined after the first render-and-compare, and accepted.
+struct HypothesisStats {
+  int proposed = 0;
+  int refined = 0;
+  int accepted = 0;
+};
+
 // Everything the detector found in one frame.
 struct Detection {
   std::vector<Eigen::Vector3f> edge_points;  // camera frame, m
@@ -114,6 +122,7 @@ struct Detection {
   std::vector<Corner> corners;
   std::vector<DetectedBox> boxes;  // best score first
   StageTimings timings;
+  HypothesisStats hypotheses;
 };
 
 }  // namespace cornerpose
