@@ -43,6 +43,8 @@ constexpr char kHelp[] =
     "  --samples N          neighbours sampled per point, 0 = all (64)\n"
     "  --ransac_threshold M RANSAC line inlier distance (0.01)\n"
     "  --meet_distance M    corner: largest distance between two edges' lines (0.01)\n"
+    "  --coarse_step N      organized frames: score 1 pixel in N x N first, then only\n"
+    "                       pixels near a hit; 1 = every pixel (3)\n"
     "  --threads N          worker threads (2)\n"
     "  --kdtree             unorganized clouds: score edges over a k-d tree (the\n"
     "                       paper's way) instead of projecting onto the camera grid\n"
@@ -57,7 +59,7 @@ struct Args {
 absl::StatusOr<Args> ParseArgs(const std::vector<std::string>& args) {
   static const char* kKnown[] = {"cloud",   "box",    "intrinsics", "json",    "ply",
                                  "png",     "edges",  "radius",     "threshold", "samples",
-                                 "ransac_threshold", "meet_distance", "threads"};
+                                 "ransac_threshold", "meet_distance", "threads", "coarse_step"};
   Args out;
   for (size_t i = 0; i < args.size(); ++i) {
     std::string a = args[i];
@@ -130,7 +132,8 @@ absl::Status Run(const Args& args) {
                          SetInt(args, "samples", &options.edge_points.max_samples),
                          SetDouble(args, "ransac_threshold", &options.segments.ransac_threshold_m),
                          SetDouble(args, "meet_distance", &options.clubbing.meet_distance_m),
-                         SetInt(args, "threads", &options.num_threads)}) {
+                         SetInt(args, "threads", &options.num_threads),
+                         SetInt(args, "coarse_step", &options.edge_points.coarse_step)}) {
     if (!s.ok()) return s;
   }
   options.project_unorganized = !args.kdtree;

@@ -5,6 +5,7 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <thread>
@@ -53,7 +54,30 @@ class OrganizedScorer {
         options_(options),
         focal_px_(static_cast<float>(focal_px)),
         radius2_(static_cast<float>(options.radius_m * options.radius_m)),
-        pattern_(UnitDiscPattern(std::max(options.max_samples, 1))) {}
+        pattern_(UnitDiscPattern(std::max(options.max_samples, 1))) {
+    // Neighbour offsets per radius, in quarter pixels, as index deltas into
+    // the row-major grid: the inner loop is then a load and a distance.
+    for (int bucket = 0; bucket <= kMaxBucket; ++bucket) {
+      const float radius_px = bucket / 4.0f;
+      std::vector<int>& table = offsets_[bucket];
+      if (UseFullDisc(radius_px)) {
+        const int r = static_cast<int>(std::ceil(radius_px));
+        for (int dv = -r; dv <= r; ++dv) {
+          for (int du = -r; du <= r; ++du) {
+            if ((du != 0 || dv != 0) && du * du + dv * dv <= radius_px * radius_px) {
+              table.push_back(dv * cloud.width + du);
+            }
+          }
+        }
+      } else {
+        for (const Eigen::Vector2f& o : pattern_) {
+          const int du = static_cast<int>(std::lround(o.x() * radius_px));
+          const int dv = static_cast<int>(std::lround(o.y() * radius_px));
+          if (du != 0 || dv != 0) table.push_back(dv * cloud.width + du);
+        }
+      }
+    }
+  }
 
   // The score of pixel (u, v), or -1 where it is not scored (no return,
   // neighbourhood cut by the frame, too few neighbours).
@@ -134,25 +158,13 @@ class OrganizedScorer {
     thread_local std::vector<float> dz;
     found.clear();
     const float reach2 = 2.25f * radius2_;  // 1.5 r_s: room for p's own noise
-    auto visit = [&](int du, int dv) {
-      if (du == 0 && dv == 0) return;
-      const Eigen::Vector3f* q = At(u + du, v + dv);
-      if (q == nullptr) return;
-      if ((*q - p).squaredNorm() <= reach2) found.push_back(*q);
-    };
-    if (UseFullDisc(radius_px)) {
-      const int r = static_cast<int>(std::ceil(radius_px));
-      const float r2 = radius_px * radius_px;
-      for (int dv = -r; dv <= r; ++dv) {
-        for (int du = -r; du <= r; ++du) {
-          if (du * du + dv * dv <= r2) visit(du, dv);
-        }
-      }
-    } else {
-      for (const Eigen::Vector2f& o : pattern_) {
-        visit(static_cast<int>(std::lround(o.x() * radius_px)),
-              static_cast<int>(std::lround(o.y() * radius_px)));
-      }
+    // CutByBorder() has kept the whole disc inside the image.
+    const Eigen::Vector3f* base = &cloud_.xyz[static_cast<size_t>(v) * cloud_.width + u];
+    const int bucket = std::min(kMaxBucket, static_cast<int>(radius_px * 4.0f + 0.5f));
+    for (const int off : offsets_[bucket]) {
+      const Eigen::Vector3f& q = base[off];
+      if (!(q.z() == q.z())) continue;  // NaN: no return
+      if ((q - p).squaredNorm() <= reach2) found.push_back(q);
     }
     Eigen::Vector3f centre = p;
     if (options_.denoise && found.size() >= 3) {
@@ -173,7 +185,7 @@ class OrganizedScorer {
   // True when the pixel disc of radius r around (u, v) leaves the image:
   // the neighbourhood is cut by the frame, not by the surface.
   bool CutByBorder(int u, int v, float radius_px) const {
-    const int r = static_cast<int>(std::ceil(radius_px));
+    const int r = static_cast<int>(std::ceil(std::min(radius_px, kMaxBucket / 4.0f) + 0.25f));
     return u - r < 0 || v - r < 0 || u + r >= cloud_.width || v + r >= cloud_.height;
   }
 
@@ -192,6 +204,10 @@ class OrganizedScorer {
   const float focal_px_;
   const float radius2_;
   const std::vector<Eigen::Vector2f> pattern_;
+  // Radii above kMaxBucket / 4 pixels (points nearer than ~0.17 m for the
+  // default radius and a VGA camera) use the largest table.
+  static constexpr int kMaxBucket = 256;
+  std::array<std::vector<int>, kMaxBucket + 1> offsets_;
 };
 
 EdgePoints Merge(const PointCloud& cloud, std::vector<Chunk>& chunks) {

@@ -40,7 +40,7 @@ struct EdgePointOptions {
   int coarse_step = 3;
   // The coarse pass keeps cells scoring above threshold * this, so pixels
   // at the rim of an edge band are not lost. Unitless, in (0, 1].
-  double coarse_threshold_factor = 0.7;
+  double coarse_threshold_factor = 0.85;
   // Worker threads for the per-point loop. Count, >= 1.
   int num_threads = 2;
 
