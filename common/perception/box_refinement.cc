@@ -1,6 +1,7 @@
 #include "common/perception/box_refinement.h"
 
 #include <algorithm>
+#include <array>
 #include <utility>
 #include <cmath>
 #include <limits>
@@ -248,31 +249,34 @@ std::optional<double> DistanceToPlaneEnd(const DepthImage& depth, const Eigen::V
   return std::nullopt;
 }
 
-// Distance from a side to where the face's plane ends beyond it, the
-// smallest over three lines across the side (a layer can be notched where
-// boxes were taken); nothing when any march leaves the image.
-std::optional<double> LayerRunBeyond(const DepthImage& depth, const Eigen::Vector3d& side_centre,
-                                     const Eigen::Vector3d& across, const Eigen::Vector3d& along,
-                                     double half_along, const Eigen::Vector3d& normal,
-                                     const RefinementOptions& o) {
-  std::optional<double> shortest;
-  for (double t : {-0.6, 0.0, 0.6}) {
-    const std::optional<double> d =
-        DistanceToPlaneEnd(depth, side_centre + t * half_along * along, across, normal, o);
+// Distances from a side to where the face's plane ends beyond it, along
+// three lines across the side (a layer can be notched where boxes were
+// taken); nothing when any march leaves the image.
+std::optional<std::array<double, 3>> LayerRunsBeyond(const DepthImage& depth,
+                                                     const Eigen::Vector3d& side_centre,
+                                                     const Eigen::Vector3d& across,
+                                                     const Eigen::Vector3d& along,
+                                                     double half_along,
+                                                     const Eigen::Vector3d& normal,
+                                                     const RefinementOptions& o) {
+  std::array<double, 3> runs;
+  const double offsets[3] = {-0.6, 0.0, 0.6};
+  for (int i = 0; i < 3; ++i) {
+    const std::optional<double> d = DistanceToPlaneEnd(
+        depth, side_centre + offsets[i] * half_along * along, across, normal, o);
     if (!d) return std::nullopt;
-    shortest = shortest ? std::min(*shortest, *d) : *d;
+    runs[i] = *d;
   }
-  return shortest;
+  return runs;
 }
 
 // How many tiles of size `tile`, laid with gaps of 0 to 2 tile_gap_m, make
-// a run of `extent` metres (within tile_tolerance_m); 0 when none do.
-int TileCount(double extent, double tile, const RefinementOptions& o) {
+// a run of `extent` metres (within `tolerance`); 0 when none do.
+int TileCount(double extent, double tile, double tolerance, const RefinementOptions& o) {
   const int k = static_cast<int>(std::lround(extent / (tile + o.tile_gap_m)));
   if (k < 1) return 0;
   const double slack = extent - k * tile;  // room left for k - 1 gaps
-  const bool fits = slack >= -o.tile_tolerance_m &&
-                    slack <= (k - 1) * 2.0 * o.tile_gap_m + o.tile_tolerance_m;
+  const bool fits = slack >= -tolerance && slack <= (k - 1) * 2.0 * o.tile_gap_m + tolerance;
   return fits ? k : 0;
 }
 
@@ -384,33 +388,47 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     const FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
     const Eigen::Vector3d axis_dir[2] = {f.a, f.b};
     const double size[2] = {2 * f.half_a, 2 * f.half_b};
-    double extent[2] = {size[0], size[1]};
+    // Per axis, the run of the plane through the box along three lines.
+    std::array<std::array<double, 3>, 2> extent = {{{size[0], size[0], size[0]},
+                                                    {size[1], size[1], size[1]}}};
     bool measured = true;
     for (int ax = 0; ax < 2 && measured; ++ax) {
       for (int sgn = 0; sgn < 2 && measured; ++sgn) {
         if (result.sides[2 * ax + sgn] != SideKind::kContinues) continue;
         const Eigen::Vector3d across = sgn == 0 ? axis_dir[ax] : -axis_dir[ax];
-        const std::optional<double> run =
-            LayerRunBeyond(depth, f.c + 0.5 * size[ax] * across, across, axis_dir[1 - ax],
-                           0.5 * size[1 - ax], f.n, options);
-        if (run) {
-          extent[ax] += *run + options.tile_gap_m;
-        } else {
+        const auto runs = LayerRunsBeyond(depth, f.c + 0.5 * size[ax] * across, across,
+                                          axis_dir[1 - ax], 0.5 * size[1 - ax], f.n, options);
+        if (!runs) {
           measured = false;
+          break;
         }
+        for (int l = 0; l < 3; ++l) extent[ax][l] += (*runs)[l] + options.tile_gap_m;
       }
     }
-    const int tiles = measured ? TileCount(extent[0], size[0], options) *
-                                     TileCount(extent[1], size[1], options)
-                               : 0;
+    // Tiles of (tile_a, tile_b) covering the longest runs, or 0 when some
+    // run is not a whole number of them.
+    // The hypothesis must tile within tile_tolerance_m; another reading of
+    // the face counts as possible within twice that (precision first).
+    auto tiling = [&](double tile_a, double tile_b, double tolerance) {
+      int count[2] = {0, 0};
+      const double tile[2] = {tile_a, tile_b};
+      for (int ax = 0; ax < 2; ++ax) {
+        for (double e : extent[ax]) {
+          const int n = TileCount(e, tile[ax], tolerance, options);
+          if (n == 0) return 0;
+          count[ax] = std::max(count[ax], n);
+        }
+      }
+      return count[0] * count[1];
+    };
+    const int tiles = measured ? tiling(size[0], size[1], options.tile_tolerance_m) : 0;
     bool fewest = tiles > 0;
     for (int i = 0; i < 3 && fewest; ++i) {
       for (int j = 0; j < 3 && fewest; ++j) {
         if (i == j || (std::abs(dims[i] - size[0]) < 1e-6 && std::abs(dims[j] - size[1]) < 1e-6)) {
           continue;
         }
-        const int other = TileCount(extent[0], dims[i], options) *
-                          TileCount(extent[1], dims[j], options);
+        const int other = tiling(dims[i], dims[j], 2.0 * options.tile_tolerance_m);
         if (other > 0 && other <= tiles) fewest = false;
       }
     }
