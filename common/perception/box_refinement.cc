@@ -50,9 +50,12 @@ FaceFrame MakeFaceFrame(const Eigen::Isometry3d& camera_T_box, const BoxDims& di
 }
 
 // Measured points near the face, in face coordinates.
-// Points in front of the plane (an occluder) go to `front` when given.
+// Points in front of the plane (an occluder) go to `front`; where every
+// pixel's ray meets the plane goes to `grid` (what a fully seen face would
+// give: the reference for point densities).
 std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margin,
-                                         double plane_tol, std::vector<FacePoint>* front) {
+                                         double plane_tol, std::vector<FacePoint>* front,
+                                         std::vector<FacePoint>* grid) {
   const CameraIntrinsics& k = depth.camera;
   double u0 = std::numeric_limits<double>::max(), v0 = u0, u1 = -u0, v1 = -u0;
   for (double sa : {-1.0, 1.0}) {
@@ -69,15 +72,24 @@ std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFram
   const int va = std::max(0, static_cast<int>(std::floor(v0)));
   const int vb = std::min(k.height - 1, static_cast<int>(std::ceil(v1)));
   std::vector<FacePoint> pts;
+  const double n_dot_c = f.n.dot(f.c);
   for (int v = va; v <= vb; ++v) {
     for (int u = ua; u <= ub; ++u) {
+      const Eigen::Vector3d ray = PixelRay(k, u, v);
+      if (const double n_dot_r = f.n.dot(ray); std::abs(n_dot_r) > 1e-6) {
+        const Eigen::Vector3d g = (n_dot_c / n_dot_r) * ray - f.c;
+        const FacePoint q{g.dot(f.a), g.dot(f.b), 0.0};
+        if (std::abs(q.a) <= f.half_a + margin && std::abs(q.b) <= f.half_b + margin) {
+          grid->push_back(q);
+        }
+      }
       const float z = depth.at(u, v);
       if (std::isnan(z)) continue;
-      const Eigen::Vector3d d = z * PixelRay(k, u, v) - f.c;
+      const Eigen::Vector3d d = z * ray - f.c;
       const FacePoint q{d.dot(f.a), d.dot(f.b), d.dot(f.n)};
       if (std::abs(q.a) > f.half_a + margin || std::abs(q.b) > f.half_b + margin) continue;
       if (q.n > plane_tol) {
-        if (front != nullptr) front->push_back(q);
+        front->push_back(q);
         continue;
       }
       if (q.n < -plane_tol) continue;
@@ -103,18 +115,32 @@ struct SideMeasure {
 // seam_search_m of the hypothesised side: the Kinect's depth noise is
 // spatially correlated, and a dip searched for everywhere is often noise.
 // Returns the seam's position (outward coordinate) or nothing.
-std::optional<double> FindSeam(const std::vector<FacePoint>& pts, bool along_a, double sign,
+std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
+                               const std::vector<FacePoint>& grid, bool along_a, double sign,
                                double half, double half_other, double pixel_m,
                                const RefinementOptions& o) {
   const double reach = o.side_band_m;
+  auto band = [&](const FacePoint& p, double* across) {
+    *across = sign * (along_a ? p.a : p.b) - half;
+    const double along = along_a ? p.b : p.a;
+    return std::abs(along) <= half_other - reach && std::abs(*across) < reach;
+  };
   std::vector<std::pair<double, double>> rows;  // (across - half, height)
   for (const FacePoint& p : pts) {
-    const double across = sign * (along_a ? p.a : p.b) - half;
-    const double along = along_a ? p.b : p.a;
-    if (std::abs(along) > half_other - reach || std::abs(across) >= reach) continue;
-    rows.emplace_back(across, p.n);
+    double across;
+    if (band(p, &across)) rows.emplace_back(across, p.n);
   }
-  if (rows.size() < 50) return std::nullopt;
+  std::vector<double> expected;  // where pixels meet the plane, same band
+  for (const FacePoint& p : grid) {
+    double across;
+    if (band(p, &across)) expected.push_back(across);
+  }
+  if (rows.size() < 50 || expected.size() < 50) return std::nullopt;
+  std::sort(expected.begin(), expected.end());
+  auto expected_in = [&](double lo, double hi) {
+    return static_cast<double>(std::lower_bound(expected.begin(), expected.end(), hi) -
+                               std::lower_bound(expected.begin(), expected.end(), lo));
+  };
   std::sort(rows.begin(), rows.end());
   std::vector<double> xs(rows.size()), prefix(rows.size() + 1, 0.0);
   for (size_t i = 0; i < rows.size(); ++i) {
@@ -127,17 +153,20 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts, bool along_a, 
     const size_t b = std::lower_bound(xs.begin(), xs.end(), hi) - xs.begin();
     return std::pair<double, double>(static_cast<double>(b - a), prefix[b] - prefix[a]);
   };
-  const double w = std::max(0.002, 1.5 * pixel_m);  // centre window width
-  const double f0 = w / 2 + pixel_m, f1 = w / 2 + 5 * pixel_m;  // flanks
+  const double w = std::max(0.003, 2.5 * pixel_m);  // centre window width
+  const double f0 = w / 2 + pixel_m, f1 = w / 2 + 6 * pixel_m;  // flanks
   std::optional<double> best;
   double best_strength = 0.0;
   for (double c = -o.seam_search_m; c <= o.seam_search_m + 1e-9; c += 0.001) {
     const auto [nc, sc] = window(c - w / 2, c + w / 2);
     const auto [nl, sl] = window(c - f1, c - f0);
     const auto [nr, sr] = window(c + f0, c + f1);
-    if (nl < 10 || nr < 10) continue;
-    const double flank_density = (nl + nr) / (2.0 * (f1 - f0));
-    const double density_ratio = (nc / w) / flank_density;
+    const double ec = expected_in(c - w / 2, c + w / 2);
+    const double ef = expected_in(c - f1, c - f0) + expected_in(c + f0, c + f1);
+    if (nl < 10 || nr < 10 || ec < 5 || ef < 10) continue;
+    // Share of the pixels that should see the plane and do, at the centre
+    // against the flanks: the pixel grid's own pattern cancels out.
+    const double density_ratio = (nc / ec) / ((nl + nr) / ef);
     const double groove =
         nc >= 5 ? (sl + sr) / (nl + nr) - sc / nc : 0.0;  // how much lower the centre is
     // Strength: how far past its threshold each test is.
@@ -153,7 +182,7 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts, bool along_a, 
 }
 
 SideMeasure MeasureSide(const std::vector<FacePoint>& pts, const std::vector<FacePoint>& front,
-                        bool along_a, double sign, double half, double half_other, double pixel_m,
+                        const std::vector<FacePoint>& grid, bool along_a, double sign, double half, double half_other, double pixel_m,
                         const RefinementOptions& o) {
   const double band = o.side_band_m;
   int inner = 0, outer = 0;
@@ -188,7 +217,7 @@ SideMeasure MeasureSide(const std::vector<FacePoint>& pts, const std::vector<Fac
   if (outer > o.free_side_ratio * inner) {
     // The face continues past the side: a seam to a touching box, or the
     // hypothesis is too small for this face.
-    if (std::optional<double> seam = FindSeam(pts, along_a, sign, half, half_other, pixel_m, o)) {
+    if (std::optional<double> seam = FindSeam(pts, grid, along_a, sign, half, half_other, pixel_m, o)) {
       m.kind = SideKind::kSeam;
       m.position = *seam;
     } else {
@@ -303,9 +332,9 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
   Eigen::Isometry3d pose = initial;
   for (int it = 0; it < std::max(1, options.iterations); ++it) {
     FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
-    std::vector<FacePoint> front;
-    const std::vector<FacePoint> pts =
-        CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m, &front);
+    std::vector<FacePoint> front, grid;
+    const std::vector<FacePoint> pts = CollectFacePoints(depth, f, options.side_band_m,
+                                                         options.plane_tolerance_m, &front, &grid);
     const double pixel_m = f.c.z() / depth.camera.fx;  // point spacing on the face
     // Plane through the interior points.
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -330,10 +359,10 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     result.face_points = n;
 
     // Sides: +a, -a, +b, -b.
-    const SideMeasure pa = MeasureSide(pts, front, true, 1.0, f.half_a, f.half_b, pixel_m, options);
-    const SideMeasure ma = MeasureSide(pts, front, true, -1.0, f.half_a, f.half_b, pixel_m, options);
-    const SideMeasure pb = MeasureSide(pts, front, false, 1.0, f.half_b, f.half_a, pixel_m, options);
-    const SideMeasure mb = MeasureSide(pts, front, false, -1.0, f.half_b, f.half_a, pixel_m, options);
+    const SideMeasure pa = MeasureSide(pts, front, grid, true, 1.0, f.half_a, f.half_b, pixel_m, options);
+    const SideMeasure ma = MeasureSide(pts, front, grid, true, -1.0, f.half_a, f.half_b, pixel_m, options);
+    const SideMeasure pb = MeasureSide(pts, front, grid, false, 1.0, f.half_b, f.half_a, pixel_m, options);
+    const SideMeasure mb = MeasureSide(pts, front, grid, false, -1.0, f.half_b, f.half_a, pixel_m, options);
     result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
     result.free_sides = 0;
     for (SideKind k : result.sides) result.free_sides += k == SideKind::kFree;

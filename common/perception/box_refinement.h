@@ -29,7 +29,7 @@ struct RefinementOptions {
   // Fine seams (gaps under ~1 mm) can show neither; the side then counts as
   // continuing and the box is not returned rather than guessed.
   double min_seam_depth_m = 0.0015;
-  double max_seam_density = 0.7;
+  double max_seam_density = 0.75;
   // The groove is looked for this far either side of the hypothesised side.
   // Metres.
   double seam_search_m = 0.006;

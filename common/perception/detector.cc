@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -35,6 +36,12 @@ double Judge(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& 
   const double grasp_support = g.visible() > 0 ? static_cast<double>(g.agree) / g.visible() : 0.0;
   if (grasp_occluded > o.max_grasp_occluded || grasp_support < o.min_grasp_support) return -1.0;
   if (ev.support() < o.min_support || ev.see_through_fraction() > o.max_see_through) return -1.0;
+  // A box mostly hidden behind what is in front of it is more often a box
+  // pushed through a surface (the floor, a neighbour) than a real one.
+  if (ev.total.expected > 0 &&
+      static_cast<double>(ev.total.occluded) / ev.total.expected > o.max_occluded) {
+    return -1.0;
+  }
   // The in-plane position must be measured, not guessed: a free side along
   // each of the face's axes.
   const int fi = static_cast<int>(grasp);
@@ -171,6 +178,25 @@ class HypothesisJudge {
   HypothesisStats stats_;
 };
 
+// Points with a NaN, an infinity or a coordinate beyond any depth camera's
+// range in any axis become NaN points (no return), so one bad value cannot
+// poison the intrinsics fit or a neighbourhood. Copies only when needed.
+const PointCloud& SanitizeCloud(const PointCloud& cloud, PointCloud* storage) {
+  constexpr float kMaxCoordinate = 100.0f;  // metres
+  auto bad = [](const Eigen::Vector3f& p) {
+    return !(std::abs(p.x()) <= kMaxCoordinate && std::abs(p.y()) <= kMaxCoordinate &&
+             std::abs(p.z()) <= kMaxCoordinate) &&
+           !(std::isnan(p.x()) && std::isnan(p.y()) && std::isnan(p.z()));
+  };
+  if (std::none_of(cloud.xyz.begin(), cloud.xyz.end(), bad)) return cloud;
+  *storage = cloud;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (Eigen::Vector3f& p : storage->xyz) {
+    if (bad(p)) p = Eigen::Vector3f(nan, nan, nan);
+  }
+  return *storage;
+}
+
 }  // namespace
 
 absl::Status AcceptanceOptions::Validate() const {
@@ -203,10 +229,12 @@ absl::Status DetectorOptions::Validate() const {
   return absl::OkStatus();
 }
 
-absl::StatusOr<Detection> DetectBoxes(const PointCloud& cloud, const DetectorOptions& options_in) {
+absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOptions& options_in) {
   const Clock::time_point t_start = Clock::now();
   if (absl::Status s = options_in.Validate(); !s.ok()) return s;
-  if (absl::Status s = cloud.Validate(); !s.ok()) return s;
+  if (absl::Status s = input.Validate(); !s.ok()) return s;
+  PointCloud sanitized;
+  const PointCloud& cloud = SanitizeCloud(input, &sanitized);
   if (cloud.size() > static_cast<size_t>(options_in.max_points)) {
     return absl::InvalidArgumentError(absl::StrCat("cloud has ", cloud.size(),
                                                    " points, above the limit of ",

@@ -24,6 +24,9 @@ struct AcceptanceOptions {
   double min_grasp_support = 0.8;
   // Share of the grasp face that may be hidden by something in front. Unitless.
   double max_grasp_occluded = 0.25;
+  // Largest share of the box's rendered pixels hidden by something in front
+  // of it. Unitless.
+  double max_occluded = 0.3;
   // Largest share of rendered pixels seen through the box (free space or
   // points inside its volume where the box would be). Unitless.
   double max_see_through = 0.06;

@@ -296,6 +296,7 @@ std::pair<int, int> FindExtremities(const std::vector<Eigen::Vector3f>& points, 
   std::sort(order.begin(), order.end());
   const float r = static_cast<float>(radius_m), r2 = r * r;
   const Eigen::Vector3f& pr = points[reference];
+  const float t_ref = axis.T(pr);
 
   // Extremity candidates with their distance and direction to the reference.
   struct Candidate {
@@ -314,7 +315,10 @@ std::pair<int, int> FindExtremities(const std::vector<Eigen::Vector3f>& points, 
            m += dir) {
         const Eigen::Vector3f d2 = points[order[m].second] - points[i];
         if (d2.squaredNorm() > r2 || d2.squaredNorm() == 0.0f) continue;
-        if (d1.dot(d2) < 0.0f) {
+        // The paper's d1 . d2 < 0, taken along the line: the points lie in
+        // the RANSAC tube, and across it a neighbour beside the query point
+        // would tip the sign either way.
+        if ((order[m].first - order[k].first) * (t_ref - order[k].first) < 0.0f) {
           extreme = false;
           break;
         }

@@ -9,6 +9,10 @@ absl::Status PointCloud::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("cloud size ", width, " x ", height, " is negative"));
   }
+  if ((width == 0) != (height == 0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cloud size ", width, " x ", height, ": one side is zero"));
+  }
   if (static_cast<size_t>(width) * static_cast<size_t>(height) != xyz.size()) {
     return absl::InvalidArgumentError(absl::StrCat("cloud is ", width, " x ", height, " but holds ",
                                                    xyz.size(), " points"));

@@ -27,9 +27,13 @@ struct PointCloud {
   bool organized() const { return height > 1; }
   size_t size() const { return xyz.size(); }
   bool empty() const { return xyz.empty(); }
+  // The detector marks every point it cannot use (a NaN, an infinity or an
+  // absurd coordinate in any axis) with a NaN z, so this test suffices
+  // inside it (see SanitizeCloud in detector.cc).
   static bool IsValid(const Eigen::Vector3f& p) { return std::isfinite(p.z()); }
 
-  // OK when width * height == xyz.size() and both are positive (or all zero).
+  // OK when width * height == xyz.size() and both are positive, or all are
+  // zero (an empty cloud).
   absl::Status Validate() const;
 };
 

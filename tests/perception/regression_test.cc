@@ -1,0 +1,186 @@
+// Regression tests: each one reproduces a detector bug found while the
+// stage tests were written (and failed before its fix). The comments say
+// what the bug was.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "common/perception/box_refinement.h"
+#include "common/perception/camera_model.h"
+#include "common/perception/detector.h"
+#include "common/perception/edge_segments.h"
+#include "common/perception/pose_error.h"
+#include "tests/support/scene_generator.h"
+
+namespace cornerpose::testing {
+namespace {
+
+// Was: FindExtremities (common/perception/edge_segments.cc, the
+// `d1.dot(d2) < 0.0f` test) decides "all neighbours lie on the reference's
+// side" with full 3-D vectors. A point of a band that sits beside the
+// reference, across the line, has d1 almost perpendicular to the line, and
+// every neighbour along the line then lies on the reference's side of it:
+// it is taken as an extremity, e1 lands next to the reference and the
+// segment is cut in the middle of a dense run. The side test should use the
+// position along the run's axis (sign of (t_ref - t_i) * (t_j - t_i)).
+TEST(RegressionTest, FindExtremitiesIgnoresAPointBesideTheReference) {
+  std::vector<Eigen::Vector3f> pts;
+  for (int i = 0; i <= 100; ++i) pts.emplace_back(0.002f * i, 0.0f, 1.0f);  // x in [0, 0.2]
+  const int reference = 50;                                                 // x = 0.1
+  pts.emplace_back(0.1f, 0.004f, 1.0f);  // 4 mm beside the reference, across the line
+  const auto [e1, e2] = FindExtremities(pts, reference, 0.02);
+  // Expected: the two ends of the run, x = 0 and x = 0.2.
+  // Actual: e1 is the point beside the reference (index 101), e2 the reference.
+  const float lo = std::min(pts[e1].x(), pts[e2].x());
+  const float hi = std::max(pts[e1].x(), pts[e2].x());
+  EXPECT_NEAR(lo, 0.0f, 1e-4f);
+  EXPECT_NEAR(hi, 0.2f, 1e-4f);
+}
+
+// The same bug on data like the detector's: the sides of a rectangle drawn
+// as 2 mm (1 sigma) noisy bands. About one seed in four splits a side into
+// two segments although the band has no gap (seeds 1, 4, 6, 8, 11, ... of
+// 100). Seed 1: the 0.30 m side from (0.16, 0.12, 1.25) splits at (0.00,
+// 0.06, 1.25) into 0.167 m + 0.119 m.
+TEST(RegressionTest, NoisyRectangleSidesAreNotSplit) {
+  const Eigen::Matrix3d R = (Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitX()))
+                                .toRotationMatrix();
+  const Eigen::Vector3d c(0.05, -0.02, 1.2);
+  const std::array<Eigen::Vector3d, 4> corners = {
+      c + R * Eigen::Vector3d(-0.15, -0.10, 0), c + R * Eigen::Vector3d(0.15, -0.10, 0),
+      c + R * Eigen::Vector3d(0.15, 0.10, 0), c + R * Eigen::Vector3d(-0.15, 0.10, 0)};
+  for (uint32_t seed : {1u, 4u, 6u, 8u, 11u}) {
+    std::mt19937 rng(seed);
+    std::vector<Eigen::Vector3f> pts;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d a = corners[k], b = corners[(k + 1) % 4];
+      const Eigen::Vector3d d = (b - a).normalized();
+      const Eigen::Vector3d u = d.unitOrthogonal(), v = d.cross(u);
+      std::uniform_real_distribution<double> along(0.0, (b - a).norm());
+      std::normal_distribution<double> across(0.0, 0.002);
+      const int n = static_cast<int>(1500 * (b - a).norm());
+      for (int i = 0; i < n; ++i) {
+        pts.push_back((a + along(rng) * d + across(rng) * u + across(rng) * v).cast<float>());
+      }
+    }
+    std::shuffle(pts.begin(), pts.end(), rng);
+    const auto segments = FitEdgeSegments(pts, EdgeSegmentOptions{});
+    ASSERT_TRUE(segments.ok());
+    EXPECT_EQ(segments->size(), 4u) << "seed " << seed;
+  }
+}
+
+constexpr BoxDims kCartonS{0.30, 0.20, 0.15};
+
+// Was: DetectBoxes returns wrong boxes with high scores. The hypothesis is a
+// box stood on end (l vertical) whose b x h face covers half of a real top
+// face, its lower half sunk into the floor. Nothing contradicts it: the
+// sunk part is hidden behind the floor and counts as "occluded", not
+// "seen through" (box_evidence.cc has no notion of the floor), and the side
+// of its grasp face that lies in the middle of the real top face, where the
+// face runs on flat, is taken for a seam (see the next test). The true box,
+// scored lower, is then dropped as overlapping the wrong one (with
+// acceptance.overlap_margin_m = 0.2 both come out: the true one scores
+// 0.921, the wrong one 0.922). As of commit fcd3206: isolated carton_s seed
+// 2 (105.5 mm / 89.9 deg off, 150 mm into the floor, score 0.92, grasp face
+// +x, sides free/free/seam/free), isolated brick seeds 4 and 15 (~85 mm /
+// 118 deg, 134 mm into the floor) and carton_s heaps (10 boxes) seeds 11
+// and 12; versions of the detector an hour apart showed it on other seeds
+// (brick 1, 6 and 20, heap 7). tests/perception/detector_test.cc counts these boxes
+// apart (kSunkBelowFloorM).
+TEST(RegressionTest, NoWrongBoxOnIsolatedAndHeapScenes) {
+  struct Case {
+    bool heap;
+    BoxDims dims;
+    uint32_t seed;
+  };
+  const BoxDims brick{0.19, 0.09, 0.057};
+  for (const Case& c : {Case{false, kCartonS, 2}, Case{false, brick, 4}, Case{false, brick, 15},
+                        Case{true, kCartonS, 11}, Case{true, kCartonS, 12}}) {
+    const Scene scene =
+        c.heap ? MakeHeapScene(c.dims, 10, c.seed) : MakeIsolatedScene(c.dims, 3, c.seed);
+    const RenderedScene out = Render(scene, NoiseOptions{});
+    DetectorOptions options;
+    options.box = c.dims;
+    const absl::StatusOr<Detection> det = DetectBoxes(out.cloud, options);
+    ASSERT_TRUE(det.ok());
+    for (const DetectedBox& box : det->boxes) {
+      double nearest_m = 1e9, nearest_deg = 1e9;
+      for (const GroundTruthBox& gt : out.boxes) {
+        const PoseError e = ComparePoses(box.camera_T_box, gt.camera_T_box, c.dims);
+        if (e.translation_m < nearest_m) {
+          nearest_m = e.translation_m;
+          nearest_deg = e.rotation_deg;
+        }
+      }
+      EXPECT_LT(nearest_m, 0.02) << (c.heap ? "heap" : "isolated") << " l=" << c.dims.l << " seed "
+                                 << c.seed << ": box off by " << nearest_deg << " deg, score "
+                                 << box.score;
+    }
+  }
+}
+
+// Was: RefineOnGraspFace (box_refinement.cc, FindSeam called from
+// MeasureSide) reports a seam in the middle of a flat, noise-free face.
+// Isolated carton_s seed 2 rendered without noise; the hypothesis of the
+// previous test built from ground-truth box 0: its +x face is the -x half
+// of the real top face. The side of that face at the top's middle line,
+// where the real face runs on flat and unbroken, comes out kSeam (with the
+// Kinect noise of the default render it comes out kContinues, as it
+// should). Half the hypotheses built the same way on seeds 1-20 come out
+// kContinues or kTiled; this one is a seam.
+TEST(RegressionTest, NoSeamInTheMiddleOfANoiseFreeFlatFace) {
+  NoiseOptions noise;
+  noise.enabled = false;
+  const RenderedScene out = Render(MakeIsolatedScene(kCartonS, 3, 2), noise);
+  const DepthImage depth = MakeDepthImage(out.cloud, out.camera);
+  // Box x along the true z (up), box z along the true -x; centre on the
+  // floor under the middle of the -x half of the top.
+  Eigen::Matrix3d R;
+  R.col(0) = Eigen::Vector3d::UnitZ();
+  R.col(2) = -Eigen::Vector3d::UnitX();
+  R.col(1) = R.col(2).cross(R.col(0));
+  Eigen::Isometry3d true_T_hyp = Eigen::Isometry3d::Identity();
+  true_T_hyp.linear() = R;
+  true_T_hyp.translation() = Eigen::Vector3d(-0.075, 0.0, -0.075);
+  Eigen::Isometry3d pose = out.boxes.at(0).camera_T_box * true_T_hyp;
+  const RefinementResult r =
+      RefineOnGraspFace(depth, kCartonS, BoxFace::kPlusX, RefinementOptions{}, &pose);
+  // sides: +a, -a, +b, -b; -b lies on the middle line of the real top face.
+  EXPECT_NE(r.sides[3], SideKind::kSeam);
+}
+
+// Was: one point with a finite z but a NaN or infinite x or y (or a wild
+// finite one, x = 1e30) makes DetectBoxes return OK with no boxes at all.
+// PointCloud::IsValid (types.h) checks z only; EstimateIntrinsics
+// (camera_model.cc) sums x/z and y/z over valid pixels on a grid (every 3rd
+// pixel for 640 x 480), so one such pixel on the grid makes the sums NaN
+// (or the plain least squares wrong) and it fails; DetectBoxes (detector.cc)
+// treats that as "too few valid points" and returns an empty Detection.
+// Pixel (300, 300) is on the grid; isolated carton_s seed 1 has 3 boxes.
+TEST(RegressionTest, OneBadCoordinateDoesNotHideEveryBox) {
+  const RenderedScene out = Render(MakeIsolatedScene(kCartonS, 3, 1), NoiseOptions{});
+  DetectorOptions options;
+  options.box = kCartonS;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int what = 0; what < 3; ++what) {
+    PointCloud cloud = out.cloud;
+    Eigen::Vector3f& p = cloud.xyz[300 * 640 + 300];
+    ASSERT_TRUE(PointCloud::IsValid(p));
+    if (what == 0) p.x() = nan;
+    if (what == 1) p.y() = std::numeric_limits<float>::infinity();
+    if (what == 2) p.x() = 1e30f;
+    const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
+    ASSERT_TRUE(det.ok());
+    EXPECT_EQ(det->boxes.size(), 3u) << "case " << what;
+  }
+}
+
+}  // namespace
+}  // namespace cornerpose::testing
