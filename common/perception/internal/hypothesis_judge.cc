@@ -1,0 +1,177 @@
+#include "common/perception/internal/hypothesis_judge.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <thread>
+
+#include "common/perception/pose_error.h"
+
+namespace cornerpose::internal {
+
+double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
+                    BoxFace grasp, const AcceptanceOptions& o) {
+  if (!ev.in_front_of_camera || !ref.ok) return -1.0;
+  const FaceEvidence& g = ev.faces[static_cast<int>(grasp)];
+  if (g.expected < o.min_grasp_pixels) return -1.0;
+  const double grasp_occluded = static_cast<double>(g.occluded) / g.expected;
+  const double grasp_support = g.visible() > 0 ? static_cast<double>(g.agree) / g.visible() : 0.0;
+  if (grasp_occluded > o.max_grasp_occluded || grasp_support < o.min_grasp_support) return -1.0;
+  if (ev.support() < o.min_support || ev.see_through_fraction() > o.max_see_through) return -1.0;
+  // A box mostly hidden behind what is in front of it is more often a box
+  // pushed through a surface (the floor, a neighbour) than a real one.
+  if (ev.total.expected > 0 &&
+      static_cast<double>(ev.total.occluded) / ev.total.expected > o.max_occluded) {
+    return -1.0;
+  }
+  // The in-plane position must be measured, not guessed: a free side along
+  // each of the face's axes.
+  const int fi = static_cast<int>(grasp);
+  const int axis_a = (fi / 2 + 1) % 3, axis_b = (fi / 2 + 2) % 3;
+  if (ref.extent_a_m > 0.0 && std::abs(ref.extent_a_m - dims[axis_a]) > o.extent_tolerance_m) {
+    return -1.0;
+  }
+  if (ref.extent_b_m > 0.0 && std::abs(ref.extent_b_m - dims[axis_b]) > o.extent_tolerance_m) {
+    return -1.0;
+  }
+  // Every side that can be seen must end the face: a free border or a seam
+  // to a touching box. A face that runs on flat is a bigger face.
+  int measured = 0;
+  for (SideKind k : ref.sides) {
+    if (k == SideKind::kContinues) return -1.0;
+    measured += k == SideKind::kFree || k == SideKind::kSeam || k == SideKind::kTiled;
+  }
+  // At least two sides pin the face down; a face with no free side must be
+  // boxed in on all four (by seams or whole tiles of its layer).
+  if (measured < 2 || (ref.free_sides < 1 && measured < 4)) return -1.0;
+  // A side hidden under something may hide more face: keep the box only if
+  // no bigger side of the box could stand in for this one there.
+  for (int s = 0; s < 4; ++s) {
+    if (ref.sides[s] != SideKind::kOccluded) continue;
+    const int here = s < 2 ? axis_a : axis_b, other = s < 2 ? axis_b : axis_a;
+    for (int k = 0; k < 3; ++k) {
+      if (k != here && k != other && dims[k] > dims[here] + o.extent_tolerance_m) return -1.0;
+      if (k == other && dims[k] > dims[here] + o.extent_tolerance_m &&
+          ref.sides[s < 2 ? 2 : 0] == SideKind::kOccluded) {
+        return -1.0;
+      }
+    }
+  }
+  return std::clamp(0.5 * grasp_support + 0.5 * ev.support() - 2.0 * ev.see_through_fraction() -
+                        0.25 * grasp_occluded,
+                    0.0, 1.0);
+}
+
+HypothesisJudge::HypothesisJudge(const DepthImage& depth, const DetectorOptions& options)
+    : depth_(depth), options_(options), symmetries_(BoxSymmetries(options.box)) {}
+
+void HypothesisJudge::Propose(const Eigen::Isometry3d& camera_T_box, int corners,
+                              std::vector<int> segments) {
+  if (Seen(camera_T_box)) return;
+  seen_.push_back(camera_T_box);
+  ++stats_.proposed;
+  queue_.push_back({camera_T_box, corners, std::move(segments)});
+}
+
+std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
+  const int n = static_cast<int>(queue_.size());
+  std::vector<Candidate> results(n);
+  std::vector<char> accepted(n, 0), refined(n, 0);
+  // Work is uneven (most hypotheses fail the first check), so threads take
+  // the next hypothesis from a shared counter.
+  std::atomic<int> next{0};
+  auto worker = [&] {
+    for (int i = next++; i < n; i = next++) {
+      bool r = false;
+      accepted[i] = EvaluateOne(queue_[i], &results[i], &r);
+      refined[i] = r;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::min(threads, n); ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  std::vector<Candidate> out;
+  for (int i = 0; i < n; ++i) {
+    stats_.refined += refined[i];
+    if (!accepted[i]) continue;
+    ++stats_.accepted;
+    out.push_back(std::move(results[i]));
+  }
+  queue_.clear();
+  return out;
+}
+
+bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refined) const {
+  Candidate& cand = *out;
+  cand.box.camera_T_box = p.camera_T_box;
+  cand.box.num_corners = p.corners;
+  cand.box.segments = p.segments;
+  const BoxEvidence first = MeasureBox(depth_, p.camera_T_box, options_.box, options_.evidence);
+  // Refinement moves a hypothesis by centimetres at most: one that the
+  // depth image already rejects by a wide margin is not worth refining.
+  const BoxFace grasp = first.grasp_face;
+  const FaceEvidence& g = first.faces[static_cast<int>(grasp)];
+  if (!first.in_front_of_camera || first.see_through_fraction() > 0.2 || first.support() < 0.4 ||
+      g.visible() <= 0 || static_cast<double>(g.agree) / g.visible() < 0.5) {
+    return false;
+  }
+  // Unrefined corners can be a centimetre off: only the refined face must
+  // lie inside the image (checked below).
+  if (!GraspFaceInView(p.camera_T_box, grasp, -20.0)) return false;
+  *refined = true;
+  cand.refinement =
+      RefineOnGraspFace(depth_, options_.box, grasp, options_.refinement, &cand.box.camera_T_box);
+  cand.evidence = MeasureBox(depth_, cand.box.camera_T_box, options_.box, options_.evidence);
+  const double score =
+      JudgeRefined(cand.evidence, cand.refinement, options_.box, grasp, options_.acceptance);
+  if (score < 0.0 ||
+      !GraspFaceInView(cand.box.camera_T_box, grasp, options_.acceptance.border_margin_px)) {
+    return false;
+  }
+  cand.box.score = score;
+  cand.box.grasp_face = cand.evidence.grasp_face;
+  const Eigen::Vector3d n_box = BoxFaceNormal(cand.box.grasp_face);
+  const int axis = static_cast<int>(cand.box.grasp_face) / 2;
+  cand.box.grasp_normal_camera = cand.box.camera_T_box.linear() * n_box;
+  cand.box.grasp_centre_camera = cand.box.camera_T_box * (n_box * options_.box[axis] / 2.0);
+  return true;
+}
+
+// A face cut by the image border cannot be checked to its end (and a
+// gripper aimed at its centre may miss the box): such boxes are not
+// returned.
+bool HypothesisJudge::GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face,
+                                      double margin) const {
+  const int f = static_cast<int>(face);
+  const int n = f / 2, a = (n + 1) % 3, b = (n + 2) % 3;
+  const CameraIntrinsics& k = depth_.camera;
+  for (double sa : {-0.5, 0.5}) {
+    for (double sb : {-0.5, 0.5}) {
+      Eigen::Vector3d local = Eigen::Vector3d::Zero();
+      local[n] = (f % 2 == 0 ? 0.5 : -0.5) * options_.box[n];
+      local[a] = sa * options_.box[a];
+      local[b] = sb * options_.box[b];
+      const Eigen::Vector3d p = pose * local;
+      if (p.z() <= 0.05) return false;
+      const Eigen::Vector2d px = Project(k, p);
+      if (px.x() < margin || px.y() < margin || px.x() > k.width - 1 - margin ||
+          px.y() > k.height - 1 - margin) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+bool HypothesisJudge::Seen(const Eigen::Isometry3d& pose) const {
+  for (const Eigen::Isometry3d& s : seen_) {
+    if ((s.translation() - pose.translation()).norm() > 0.01) continue;
+    for (const Eigen::Matrix3d& S : symmetries_) {
+      if ((s.linear() - pose.linear() * S).norm() < 0.06) return true;  // ~2.5 degrees
+    }
+  }
+  return false;
+}
+
+}  // namespace cornerpose::internal

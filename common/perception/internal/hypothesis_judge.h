@@ -1,0 +1,63 @@
+// Judging box pose hypotheses against the depth image: a cheap
+// render-and-compare first, then refinement on the grasp face and the full
+// acceptance test. Hypotheses are queued (duplicates dropped) and evaluated
+// in parallel; each evaluation only reads the depth image.
+#pragma once
+
+#include <vector>
+
+#include "common/perception/box_evidence.h"
+#include "common/perception/box_refinement.h"
+#include "common/perception/camera_model.h"
+#include "common/perception/detector.h"
+#include "common/perception/types.h"
+
+namespace cornerpose::internal {
+
+struct Candidate {
+  DetectedBox box;
+  BoxEvidence evidence;
+  RefinementResult refinement;
+};
+
+// The acceptance test of a refined hypothesis: its score in [0, 1], or < 0
+// when the depth image contradicts it (see AcceptanceOptions).
+double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
+                    BoxFace grasp, const AcceptanceOptions& o);
+
+class HypothesisJudge {
+ public:
+  HypothesisJudge(const DepthImage& depth, const DetectorOptions& options);
+
+  // Queues a pose unless one like it (same place within 1 cm, same
+  // orientation up to the box's symmetries) was proposed before: the
+  // corners of one box propose it many times.
+  void Propose(const Eigen::Isometry3d& camera_T_box, int corners, std::vector<int> segments);
+
+  // Evaluates the queue on up to `threads` threads; returns the accepted
+  // candidates in the order they were proposed, and empties the queue.
+  std::vector<Candidate> Evaluate(int threads);
+
+  const HypothesisStats& stats() const { return stats_; }
+
+ private:
+  struct Proposal {
+    Eigen::Isometry3d camera_T_box;
+    int corners;
+    std::vector<int> segments;
+  };
+  // Evaluates one proposal; false when rejected. `refined` is set when it
+  // got as far as refinement.
+  bool EvaluateOne(const Proposal& p, Candidate* out, bool* refined) const;
+  bool GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face, double margin) const;
+  bool Seen(const Eigen::Isometry3d& pose) const;
+
+  const DepthImage& depth_;
+  const DetectorOptions& options_;
+  const std::vector<Eigen::Matrix3d> symmetries_;
+  std::vector<Eigen::Isometry3d> seen_;
+  std::vector<Proposal> queue_;
+  HypothesisStats stats_;
+};
+
+}  // namespace cornerpose::internal
