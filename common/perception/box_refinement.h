@@ -40,7 +40,7 @@ struct RefinementOptions {
   double tile_tolerance_m = 0.01;
   double max_tile_march_m = 2.5;
   // Iterations of measure-and-update. Count.
-  int iterations = 3;
+  int iterations = 2;
   // Largest correction accepted, beyond which the hypothesis is not this
   // box: metres and degrees.
   double max_shift_m = 0.05;

@@ -81,7 +81,7 @@ class SegmentFitter {
         options_(o),
         alive_(pts.size(), 1),
         num_alive_(static_cast<int>(pts.size())),
-        grid_(pts, static_cast<float>(o.sample_max_m)),
+        grid_(pts, static_cast<float>(o.sample_max_m / 2.0)),
         rng_(o.seed) {}
 
   std::vector<EdgeSegment> Run() {

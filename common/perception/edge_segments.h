@@ -25,7 +25,7 @@ struct EdgeSegmentOptions {
   int ransac_iterations = 120;
   // RANSAC scores hypotheses on at most this many of the remaining points
   // (a random subset); the chosen line is then fitted on all of them. Count.
-  int ransac_subset = 3000;
+  int ransac_subset = 1000;
   // The second point of a hypothesis is drawn at this distance from the
   // first, so both tend to lie on one edge. Metres.
   double sample_min_m = 0.03;
