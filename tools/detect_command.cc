@@ -45,6 +45,9 @@ constexpr char kHelp[] =
     "  --meet_distance M    corner: largest distance between two edges' lines (0.01)\n"
     "  --coarse_step N      organized frames: score 1 pixel in N x N first, then only\n"
     "                       pixels near a hit; 1 = every pixel (3)\n"
+    "  --denoise BOOL       score from the neighbours' median depth (true); false is\n"
+    "                       the paper's formula exactly, for clouds not taken by a camera\n"
+    "                       at the origin\n"
     "  --threads N          worker threads (2)\n"
     "  --kdtree             unorganized clouds: score edges over a k-d tree (the\n"
     "                       paper's way) instead of projecting onto the camera grid\n"
@@ -59,7 +62,7 @@ struct Args {
 absl::StatusOr<Args> ParseArgs(const std::vector<std::string>& args) {
   static const char* kKnown[] = {"cloud",   "box",    "intrinsics", "json",    "ply",
                                  "png",     "edges",  "radius",     "threshold", "samples",
-                                 "ransac_threshold", "meet_distance", "threads", "coarse_step"};
+                                 "ransac_threshold", "meet_distance", "threads", "coarse_step", "denoise"};
   Args out;
   for (size_t i = 0; i < args.size(); ++i) {
     std::string a = args[i];
@@ -108,6 +111,15 @@ absl::Status SetInt(const Args& args, const std::string& key, int* out) {
   return absl::OkStatus();
 }
 
+absl::Status SetBool(const Args& args, const std::string& key, bool* out) {
+  auto it = args.values.find(key);
+  if (it == args.values.end()) return absl::OkStatus();
+  if (!absl::SimpleAtob(it->second, out)) {
+    return absl::InvalidArgumentError(absl::StrCat("--", key, " '", it->second, "' is not true/false"));
+  }
+  return absl::OkStatus();
+}
+
 absl::Status Run(const Args& args) {
   auto get = [&](const std::string& k) -> std::optional<std::string> {
     auto it = args.values.find(k);
@@ -133,7 +145,8 @@ absl::Status Run(const Args& args) {
                          SetDouble(args, "ransac_threshold", &options.segments.ransac_threshold_m),
                          SetDouble(args, "meet_distance", &options.clubbing.meet_distance_m),
                          SetInt(args, "threads", &options.num_threads),
-                         SetInt(args, "coarse_step", &options.edge_points.coarse_step)}) {
+                         SetInt(args, "coarse_step", &options.edge_points.coarse_step),
+                         SetBool(args, "denoise", &options.edge_points.denoise)}) {
     if (!s.ok()) return s;
   }
   options.project_unorganized = !args.kdtree;

@@ -98,9 +98,17 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   }
   // A single-view unorganized cloud is laid back onto the camera's pixel
   // grid, so it takes the same (fast, shadow-aware) path as a frame.
+  // A cloud that is not in a camera's frame (a merged scan, an object
+  // model) mostly falls outside the image: it keeps the k-d tree path.
   PointCloud projected;
-  const bool project = !cloud.organized() && options.project_unorganized;
-  if (project) projected = OrganizeByProjection(cloud, camera);
+  bool project = !cloud.organized() && options.project_unorganized;
+  if (project) {
+    projected = OrganizeByProjection(cloud, camera);
+    const auto valid = [](const std::vector<Eigen::Vector3f>& xyz) {
+      return std::count_if(xyz.begin(), xyz.end(), PointCloud::IsValid);
+    };
+    project = 2 * valid(projected.xyz) >= valid(cloud.xyz);
+  }
   const PointCloud& work = project ? projected : cloud;
   const DepthImage depth = MakeDepthImage(work, camera);
   det.timings.preprocess_ms = MsSince(t_start);

@@ -63,7 +63,8 @@ struct DetectorOptions {
   // Unorganized clouds are projected through `camera` onto its pixel grid
   // (the nearest point per pixel) and processed like a frame. Right for a
   // cloud from one depth camera, in its frame; for merged or foreign clouds
-  // set it false to score edges over a k-d tree as the paper does.
+  // set it false to score edges over a k-d tree as the paper does (also
+  // done when fewer than half the points project into the image).
   bool project_unorganized = true;
   // Worker threads (edge points). Count.
   int num_threads = 2;
