@@ -169,15 +169,23 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
     const double density_ratio = (nc / ec) / ((nl + nr) / ef);
     const double groove =
         nc >= 5 ? (sl + sr) / (nl + nr) - sc / nc : 0.0;  // how much lower the centre is
-    // Strength: how far past its threshold each test is.
-    const double strength = std::max((o.max_seam_density - density_ratio) / o.max_seam_density,
-                                     (groove - o.min_seam_depth_m) / o.min_seam_depth_m);
+    // Strength: how far past its threshold each test is; a weaker dip in
+    // density counts when a groove half as deep as the threshold backs it.
+    const double density_strength =
+        (o.max_seam_density - density_ratio) / o.max_seam_density;
+    const double groove_strength = (groove - o.min_seam_depth_m) / o.min_seam_depth_m;
+    const double joint_strength =
+        std::min((o.weak_seam_density - density_ratio) / o.weak_seam_density,
+                 (groove - 0.5 * o.min_seam_depth_m) / o.min_seam_depth_m);
+    const double strength = std::max({density_strength, groove_strength, joint_strength});
     if (strength > 0.0 && strength > best_strength) {
       best_strength = strength;
       best = c;
     }
   }
-  if (!best) return std::nullopt;
+  // A dip at the end of the search range is the flank of something
+  // further away, not a seam here.
+  if (!best || std::abs(*best) > o.seam_search_m - 0.0015) return std::nullopt;
   return half + *best;
 }
 
@@ -245,6 +253,32 @@ SideMeasure MeasureSide(const std::vector<FacePoint>& pts, const std::vector<Fac
   m.slope = slopes.empty() ? 0.0 : Median(slopes);
   m.kind = SideKind::kFree;
   return m;
+}
+
+// True when, past a side, the first surface after a run of missing returns
+// lies in front of the face's plane: the gap is the shadow of something
+// standing over the face, which may go on underneath it, so the side is not
+// where the face ends. Looks up to 8 cm out along three lines.
+bool ShadowedByOccluder(const DepthImage& depth, const Eigen::Vector3d& side_centre,
+                        const Eigen::Vector3d& across, const Eigen::Vector3d& along,
+                        double half_along, const Eigen::Vector3d& normal,
+                        const RefinementOptions& o) {
+  for (double t : {-0.6, 0.0, 0.6}) {
+    const Eigen::Vector3d start = side_centre + t * half_along * along;
+    for (double d = 0.004; d < 0.08; d += 0.003) {
+      const Eigen::Vector3d q = start + d * across;
+      if (q.z() <= 0.05) break;
+      const Eigen::Vector2d px = Project(depth.camera, q);
+      const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+      if (!depth.inside(u, v)) break;
+      const float z = depth.at(u, v);
+      if (std::isnan(z)) continue;
+      const double height = (z * PixelRay(depth.camera, u, v) - q).dot(normal);
+      if (height > o.plane_tolerance_m && d > 0.012) return true;
+      break;  // a surface at or behind the plane: a real end
+    }
+  }
+  return false;
 }
 
 // Where the face's plane ends beyond one side: marches outward from the
@@ -402,6 +436,23 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     R.col(f.axis_b) = b_cam;
     pose.linear() = R;
     pose.translation() = centre - n_cam * dims[f.axis_n] / 2.0;
+  }
+  // A free side whose edge is the border of a shadow cast by something
+  // standing over the face is no edge of the face.
+  {
+    const FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
+    const Eigen::Vector3d across[4] = {f.a, -f.a, f.b, -f.b};
+    const Eigen::Vector3d along[4] = {f.b, f.b, f.a, f.a};
+    const double half_across[4] = {f.half_a, f.half_a, f.half_b, f.half_b};
+    const double half_along[4] = {f.half_b, f.half_b, f.half_a, f.half_a};
+    for (int i = 0; i < 4; ++i) {
+      if (result.sides[i] == SideKind::kFree &&
+          ShadowedByOccluder(depth, f.c + half_across[i] * across[i], across[i], along[i],
+                             half_along[i], f.n, options)) {
+        result.sides[i] = SideKind::kOccluded;
+        --result.free_sides;
+      }
+    }
   }
   // Sides where the face runs on without a visible seam (pallet layers with
   // fine gaps): the face may be one tile of a layer of touching boxes, or a

@@ -25,14 +25,18 @@ struct RefinementOptions {
   double free_side_ratio = 0.15;
   // Least depth of the groove between two touching coplanar faces. Metres.
   // A seam is a groove at least this deep (metres) or a line where the
-  // density of points on the plane falls below this share of its flanks'.
+  // share of pixels that see the plane falls below this share of its
+  // flanks'.
   // Fine seams (gaps under ~1 mm) can show neither; the side then counts as
   // continuing and the box is not returned rather than guessed.
   double min_seam_depth_m = 0.0015;
   double max_seam_density = 0.75;
+  // A density dip down to this share also makes a seam when a groove of
+  // half min_seam_depth_m comes with it.
+  double weak_seam_density = 0.85;
   // The groove is looked for this far either side of the hypothesised side.
   // Metres.
-  double seam_search_m = 0.006;
+  double seam_search_m = 0.008;
   // A face that runs on past a side is one tile of a layer when the layer
   // ends a whole number of (box size + tile_gap_m) away, within
   // tile_tolerance_m, searched up to max_tile_march_m (0 disables). Metres.
