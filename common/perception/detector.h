@@ -29,12 +29,15 @@ struct AcceptanceOptions {
   double max_occluded = 0.3;
   // Largest share of rendered pixels seen through the box (free space or
   // points inside its volume where the box would be). Unitless.
-  double max_see_through = 0.06;
+  double max_see_through = 0.04;
   // Grasp face pixels needed (at the sampling the evidence uses). Count.
   int min_grasp_pixels = 60;
   // A face measured between two free sides must match its known size within
   // this. Metres.
   double extent_tolerance_m = 0.025;
+  // Largest angle between the grasp face's normal and the line of sight to
+  // its centre. Degrees.
+  double max_grasp_view_angle_deg = 60.0;
   // The grasp face must project this far inside the image. Pixels.
   double border_margin_px = 3.0;
   // Two accepted boxes may not overlap by more than this (each is shrunk by

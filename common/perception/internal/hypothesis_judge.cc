@@ -135,7 +135,11 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   const int axis = static_cast<int>(cand.box.grasp_face) / 2;
   cand.box.grasp_normal_camera = cand.box.camera_T_box.linear() * n_box;
   cand.box.grasp_centre_camera = cand.box.camera_T_box * (n_box * options_.box[axis] / 2.0);
-  return true;
+  // A face seen nearly edge-on has too few, too noisy points to confirm a
+  // box by, and is where the sides of pallets and bins pass for one.
+  const double cos_view =
+      -cand.box.grasp_normal_camera.dot(cand.box.grasp_centre_camera.normalized());
+  return cos_view >= std::cos(options_.acceptance.max_grasp_view_angle_deg * M_PI / 180.0);
 }
 
 // A face cut by the image border cannot be checked to its end (and a
