@@ -36,7 +36,7 @@ struct RefinementOptions {
   double weak_seam_density = 0.85;
   // The groove is looked for this far either side of the hypothesised side.
   // Metres.
-  double seam_search_m = 0.008;
+  double seam_search_m = 0.006;
   // A face that runs on past a side is one tile of a layer when the layer
   // ends a whole number of (box size + tile_gap_m) away, within
   // tile_tolerance_m, searched up to max_tile_march_m (0 disables). Metres.

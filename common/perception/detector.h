@@ -29,7 +29,7 @@ struct AcceptanceOptions {
   double max_occluded = 0.3;
   // Largest share of rendered pixels seen through the box (free space or
   // points inside its volume where the box would be). Unitless.
-  double max_see_through = 0.04;
+  double max_see_through = 0.05;
   // Grasp face pixels needed (at the sampling the evidence uses). Count.
   int min_grasp_pixels = 60;
   // A face measured between two free sides must match its known size within
