@@ -15,8 +15,8 @@
 #include "common/perception/camera_model.h"
 #include "common/perception/detector.h"
 #include "common/viz/detection_json.h"
-#include "common/viz/detection_png.h"
 #include "common/viz/detection_ply.h"
+#include "common/viz/detection_png.h"
 
 namespace cornerpose::tools {
 namespace {
@@ -60,9 +60,21 @@ struct Args {
 };
 
 absl::StatusOr<Args> ParseArgs(const std::vector<std::string>& args) {
-  static const char* kKnown[] = {"cloud",   "box",    "intrinsics", "json",    "ply",
-                                 "png",     "edges",  "radius",     "threshold", "samples",
-                                 "ransac_threshold", "meet_distance", "threads", "coarse_step", "denoise"};
+  static const char* kKnown[] = {"cloud",
+                                 "box",
+                                 "intrinsics",
+                                 "json",
+                                 "ply",
+                                 "png",
+                                 "edges",
+                                 "radius",
+                                 "threshold",
+                                 "samples",
+                                 "ransac_threshold",
+                                 "meet_distance",
+                                 "threads",
+                                 "coarse_step",
+                                 "denoise"};
   Args out;
   for (size_t i = 0; i < args.size(); ++i) {
     std::string a = args[i];
@@ -74,7 +86,8 @@ absl::StatusOr<Args> ParseArgs(const std::vector<std::string>& args) {
       out.kdtree = true;
       continue;
     }
-    if (a.rfind("--", 0) != 0) return absl::InvalidArgumentError(absl::StrCat("unexpected argument '", a, "'"));
+    if (a.rfind("--", 0) != 0)
+      return absl::InvalidArgumentError(absl::StrCat("unexpected argument '", a, "'"));
     a = a.substr(2);
     std::string value;
     if (const size_t eq = a.find('='); eq != std::string::npos) {
@@ -97,7 +110,8 @@ absl::Status SetDouble(const Args& args, const std::string& key, double* out) {
   auto it = args.values.find(key);
   if (it == args.values.end()) return absl::OkStatus();
   if (!absl::SimpleAtod(it->second, out)) {
-    return absl::InvalidArgumentError(absl::StrCat("--", key, " '", it->second, "' is not a number"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", key, " '", it->second, "' is not a number"));
   }
   return absl::OkStatus();
 }
@@ -106,7 +120,8 @@ absl::Status SetInt(const Args& args, const std::string& key, int* out) {
   auto it = args.values.find(key);
   if (it == args.values.end()) return absl::OkStatus();
   if (!absl::SimpleAtoi(it->second, out)) {
-    return absl::InvalidArgumentError(absl::StrCat("--", key, " '", it->second, "' is not an integer"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", key, " '", it->second, "' is not an integer"));
   }
   return absl::OkStatus();
 }
@@ -115,7 +130,8 @@ absl::Status SetBool(const Args& args, const std::string& key, bool* out) {
   auto it = args.values.find(key);
   if (it == args.values.end()) return absl::OkStatus();
   if (!absl::SimpleAtob(it->second, out)) {
-    return absl::InvalidArgumentError(absl::StrCat("--", key, " '", it->second, "' is not true/false"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", key, " '", it->second, "' is not true/false"));
   }
   return absl::OkStatus();
 }
@@ -166,11 +182,11 @@ absl::Status Run(const Args& args) {
       const DetectedBox& b = det->boxes[i];
       const Eigen::Vector3d t = b.camera_T_box.translation();
       const Eigen::Vector3d ypr = b.camera_T_box.linear().eulerAngles(2, 1, 0) * 180.0 / M_PI;
-      std::printf("  box %zu: score %.2f  centre (%.3f, %.3f, %.3f) m  zyx euler (%.1f, %.1f, %.1f) deg"
-                  "  grasp %s at (%.3f, %.3f, %.3f)\n",
-                  i, b.score, t.x(), t.y(), t.z(), ypr.x(), ypr.y(), ypr.z(),
-                  BoxFaceName(b.grasp_face), b.grasp_centre_camera.x(), b.grasp_centre_camera.y(),
-                  b.grasp_centre_camera.z());
+      std::printf(
+          "  box %zu: score %.2f  centre (%.3f, %.3f, %.3f) m  zyx euler (%.1f, %.1f, %.1f) deg"
+          "  grasp %s at (%.3f, %.3f, %.3f)\n",
+          i, b.score, t.x(), t.y(), t.z(), ypr.x(), ypr.y(), ypr.z(), BoxFaceName(b.grasp_face),
+          b.grasp_centre_camera.x(), b.grasp_centre_camera.y(), b.grasp_centre_camera.z());
     }
   }
   if (auto p = get("json")) {
@@ -203,7 +219,8 @@ int RunDetect(const std::vector<std::string>& argv) {
   }
   absl::StatusOr<Args> args = ParseArgs(argv);
   if (!args.ok()) {
-    std::fprintf(stderr, "cornerpose detect: %s\n\n%s", std::string(args.status().message()).c_str(), kHelp);
+    std::fprintf(stderr, "cornerpose detect: %s\n\n%s",
+                 std::string(args.status().message()).c_str(), kHelp);
     return 2;
   }
   if (absl::Status s = Run(*args); !s.ok()) {

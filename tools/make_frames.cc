@@ -14,10 +14,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
@@ -65,8 +64,8 @@ int Run(const Args& a) {
     } else if (kind == "heap") {
       scene = testing::MakeHeapScene(*dims, 6 + i % 8, seed);
     } else if (kind == "pallet") {
-      scene = testing::MakePalletScene(*dims, 3 + i % 2, 2 + i % 3, 1 + i % 2, 0.002 + 0.001 * (i % 3),
-                                       i % 4, seed);
+      scene = testing::MakePalletScene(*dims, 3 + i % 2, 2 + i % 3, 1 + i % 2,
+                                       0.002 + 0.001 * (i % 3), i % 4, seed);
     } else {
       std::fprintf(stderr, "make_frames: unknown --kind %s\n", kind.c_str());
       return 2;
@@ -79,7 +78,8 @@ int Run(const Args& a) {
       const float z = r.cloud.xyz[p].z();
       if (std::isfinite(z)) depth[p] = static_cast<uint16_t>(std::lround(z * 1000.0));
     }
-    absl::Status s = WriteDepthPng(a.out + "/" + id + ".png", depth, r.camera.width, r.camera.height);
+    absl::Status s =
+        WriteDepthPng(a.out + "/" + id + ".png", depth, r.camera.width, r.camera.height);
     if (s.ok() && a.pcd) s = SavePcd(a.out + "/" + id + ".pcd", r.cloud);
     if (!s.ok()) {
       std::fprintf(stderr, "make_frames: %s\n", s.ToString().c_str());
@@ -92,8 +92,12 @@ int Run(const Args& a) {
                          {"target_dims_name", a.box},
                          {"target_dims", {dims->l, dims->b, dims->h}},
                          {"camera",
-                          {{"width", camera.width}, {"height", camera.height}, {"fx", camera.fx},
-                           {"fy", camera.fy}, {"cx", camera.cx}, {"cy", camera.cy}}},
+                          {{"width", camera.width},
+                           {"height", camera.height},
+                           {"fx", camera.fx},
+                           {"fy", camera.fy},
+                           {"cx", camera.cx},
+                           {"cy", camera.cy}}},
                          {"generator", {{"tool", "cornerpose make_frames"}, {"seed", seed}}},
                          {"boxes", nlohmann::json::array()}};
     for (size_t b = 0; b < r.boxes.size(); ++b) {
@@ -108,8 +112,9 @@ int Run(const Args& a) {
                              {"pickable", g.pickable}});
     }
     std::ofstream(a.out + "/" + id + ".json") << gt.dump(1) << "\n";
-    index["scenes"].push_back(
-        {{"scene_id", id}, {"type", kind}, {"files", {{"gt", id + ".json"}, {"depth_png", id + ".png"}}}});
+    index["scenes"].push_back({{"scene_id", id},
+                               {"type", kind},
+                               {"files", {{"gt", id + ".json"}, {"depth_png", id + ".png"}}}});
     std::printf("%s: %zu boxes\n", id.c_str(), r.boxes.size());
   }
   std::ofstream(a.out + "/index.json") << index.dump(1) << "\n";

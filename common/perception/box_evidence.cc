@@ -11,8 +11,8 @@ namespace cornerpose {
 
 absl::Status EvidenceOptions::Validate() const {
   if (!(depth_tolerance_base_m > 0.0 && depth_tolerance_base_m <= 0.2)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "depth_tolerance_base_m=", depth_tolerance_base_m, " is outside (0, 0.2] m"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("depth_tolerance_base_m=", depth_tolerance_base_m, " is outside (0, 0.2] m"));
   }
   if (!(depth_tolerance_per_m2 >= 0.0 && depth_tolerance_per_m2 <= 0.2)) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -30,23 +30,18 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
   BoxEvidence ev;
   const CameraIntrinsics& k = depth.camera;
   // Screen-space bounds of the box.
-  double u0 = std::numeric_limits<double>::max(), v0 = u0, u1 = -u0, v1 = -u0;
-  for (const Eigen::Vector3d& c : BoxCorners(camera_T_box, dims)) {
+  const std::array<Eigen::Vector3d, 8> corners = BoxCorners(camera_T_box, dims);
+  for (const Eigen::Vector3d& c : corners) {
     if (c.z() <= 0.05) {
       ev.in_front_of_camera = false;
       return ev;
     }
-    const Eigen::Vector2d px = Project(k, c);
-    u0 = std::min(u0, px.x()), u1 = std::max(u1, px.x());
-    v0 = std::min(v0, px.y()), v1 = std::max(v1, px.y());
   }
-  const int ua = std::max(0, static_cast<int>(std::floor(u0)));
-  const int ub = std::min(k.width - 1, static_cast<int>(std::ceil(u1)));
-  const int va = std::max(0, static_cast<int>(std::floor(v0)));
-  const int vb = std::min(k.height - 1, static_cast<int>(std::ceil(v1)));
-  if (ua > ub || va > vb) return ev;
-  const double area = static_cast<double>(ub - ua + 1) * (vb - va + 1);
-  const int step = std::max(1, static_cast<int>(std::sqrt(area / options.max_samples)));
+  const std::optional<PixelRect> rect =
+      ProjectedRect(k, std::vector<Eigen::Vector3d>(corners.begin(), corners.end()));
+  if (!rect) return ev;
+  const int ua = rect->u0, ub = rect->u1, va = rect->v0, vb = rect->v1;
+  const int step = std::max(1, static_cast<int>(std::sqrt(rect->area() / options.max_samples)));
 
   // Ray casting in the box frame (slab method).
   const Eigen::Matrix3d box_R_camera = camera_T_box.linear().transpose();
@@ -56,7 +51,8 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
   for (int v = va; v <= vb; v += step) {
     for (int u = ua; u <= ub; u += step) {
       const Eigen::Vector3d dir = box_R_camera * PixelRay(k, u, v);
-      double t_near = -std::numeric_limits<double>::max(), t_far = std::numeric_limits<double>::max();
+      double t_near = -std::numeric_limits<double>::max(),
+             t_far = std::numeric_limits<double>::max();
       int near_axis = -1;
       bool hit = true;
       for (int a = 0; a < 3 && hit; ++a) {

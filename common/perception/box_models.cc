@@ -28,7 +28,8 @@ absl::StatusOr<BoxDims> BoxModelByName(absl::string_view name) {
     if (model == name) return dims;
   }
   std::string known;
-  for (const auto& [model, dims] : kModels) absl::StrAppend(&known, known.empty() ? "" : ", ", model);
+  for (const auto& [model, dims] : kModels)
+    absl::StrAppend(&known, known.empty() ? "" : ", ", model);
   return absl::NotFoundError(absl::StrCat("unknown box model '", name, "' (known: ", known, ")"));
 }
 
@@ -38,7 +39,8 @@ absl::StatusOr<BoxDims> ParseBoxDims(absl::string_view text) {
     absl::StatusOr<BoxDims> model = BoxModelByName(absl::StripAsciiWhitespace(text));
     if (!model.ok()) {
       return absl::InvalidArgumentError(absl::StrCat(
-          "box '", text, "' is neither L,B,H in metres nor a model name: ", model.status().message()));
+          "box '", text,
+          "' is neither L,B,H in metres nor a model name: ", model.status().message()));
     }
     return model;
   }

@@ -1,9 +1,8 @@
 // Named box sizes, so callers can say "carton_s" instead of three numbers.
 #pragma once
 
-#include "absl/strings/string_view.h"
-
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "common/perception/types.h"
 
 namespace cornerpose {

@@ -1,9 +1,8 @@
 #include "common/perception/box_pose.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/Geometry>
 
 #include "absl/strings/str_cat.h"
 
@@ -15,8 +14,8 @@ absl::Status PoseOptions::Validate() const {
         absl::StrCat("length_tolerance_m=", length_tolerance_m, " is outside (0, 0.5] m"));
   }
   if (!(min_occluded_fraction >= 0.0 && min_occluded_fraction <= 1.0)) {
-    return absl::InvalidArgumentError(absl::StrCat("min_occluded_fraction=",
-                                                   min_occluded_fraction, " is outside [0, 1]"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("min_occluded_fraction=", min_occluded_fraction, " is outside [0, 1]"));
   }
   if (!(corner_match_m > 0.0 && corner_match_m <= 0.5)) {
     return absl::InvalidArgumentError(

@@ -1,14 +1,13 @@
 #include "common/perception/box_refinement.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
-#include <utility>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <optional>
-
-#include <Eigen/Eigenvalues>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 
@@ -57,20 +56,15 @@ std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFram
                                          double plane_tol, std::vector<FacePoint>* front,
                                          std::vector<FacePoint>* grid) {
   const CameraIntrinsics& k = depth.camera;
-  double u0 = std::numeric_limits<double>::max(), v0 = u0, u1 = -u0, v1 = -u0;
+  std::vector<Eigen::Vector3d> outline;
   for (double sa : {-1.0, 1.0}) {
     for (double sb : {-1.0, 1.0}) {
-      const Eigen::Vector3d p = f.c + sa * (f.half_a + margin) * f.a + sb * (f.half_b + margin) * f.b;
-      if (p.z() <= 0.05) return {};
-      const Eigen::Vector2d px = Project(k, p);
-      u0 = std::min(u0, px.x()), u1 = std::max(u1, px.x());
-      v0 = std::min(v0, px.y()), v1 = std::max(v1, px.y());
+      outline.push_back(f.c + sa * (f.half_a + margin) * f.a + sb * (f.half_b + margin) * f.b);
     }
   }
-  const int ua = std::max(0, static_cast<int>(std::floor(u0)));
-  const int ub = std::min(k.width - 1, static_cast<int>(std::ceil(u1)));
-  const int va = std::max(0, static_cast<int>(std::floor(v0)));
-  const int vb = std::min(k.height - 1, static_cast<int>(std::ceil(v1)));
+  const std::optional<PixelRect> rect = ProjectedRect(k, outline);
+  if (!rect) return {};
+  const int ua = rect->u0, ub = rect->u1, va = rect->v0, vb = rect->v1;
   std::vector<FacePoint> pts;
   const double n_dot_c = f.n.dot(f.c);
   for (int v = va; v <= vb; ++v) {
@@ -153,7 +147,7 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
     const size_t b = std::lower_bound(xs.begin(), xs.end(), hi) - xs.begin();
     return std::pair<double, double>(static_cast<double>(b - a), prefix[b] - prefix[a]);
   };
-  const double w = std::max(0.003, 2.5 * pixel_m);  // centre window width
+  const double w = std::max(0.003, 2.5 * pixel_m);              // centre window width
   const double f0 = w / 2 + pixel_m, f1 = w / 2 + 6 * pixel_m;  // flanks
   std::optional<double> best;
   double best_strength = 0.0;
@@ -171,8 +165,7 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
         nc >= 5 ? (sl + sr) / (nl + nr) - sc / nc : 0.0;  // how much lower the centre is
     // Strength: how far past its threshold each test is; a weaker dip in
     // density counts when a groove half as deep as the threshold backs it.
-    const double density_strength =
-        (o.max_seam_density - density_ratio) / o.max_seam_density;
+    const double density_strength = (o.max_seam_density - density_ratio) / o.max_seam_density;
     const double groove_strength = (groove - o.min_seam_depth_m) / o.min_seam_depth_m;
     const double joint_strength =
         std::min((o.weak_seam_density - density_ratio) / o.weak_seam_density,
@@ -190,8 +183,8 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
 }
 
 SideMeasure MeasureSide(const std::vector<FacePoint>& pts, const std::vector<FacePoint>& front,
-                        const std::vector<FacePoint>& grid, bool along_a, double sign, double half, double half_other, double pixel_m,
-                        const RefinementOptions& o) {
+                        const std::vector<FacePoint>& grid, bool along_a, double sign, double half,
+                        double half_other, double pixel_m, const RefinementOptions& o) {
   const double band = o.side_band_m;
   int inner = 0, outer = 0;
   const double bin = 0.01;
@@ -216,7 +209,8 @@ SideMeasure MeasureSide(const std::vector<FacePoint>& pts, const std::vector<Fac
   for (const FacePoint& p : front) {
     const double across = sign * (along_a ? p.a : p.b);
     const double along = along_a ? p.b : p.a;
-    in_front += std::abs(along) <= half_other - band && across > half + 0.005 && across <= half + band;
+    in_front +=
+        std::abs(along) <= half_other - band && across > half + 0.005 && across <= half + band;
   }
   if (in_front > o.free_side_ratio * inner && in_front > outer) {
     m.kind = SideKind::kOccluded;
@@ -225,7 +219,8 @@ SideMeasure MeasureSide(const std::vector<FacePoint>& pts, const std::vector<Fac
   if (outer > o.free_side_ratio * inner) {
     // The face continues past the side: a seam to a touching box, or the
     // hypothesis is too small for this face.
-    if (std::optional<double> seam = FindSeam(pts, grid, along_a, sign, half, half_other, pixel_m, o)) {
+    if (std::optional<double> seam =
+            FindSeam(pts, grid, along_a, sign, half, half_other, pixel_m, o)) {
       m.kind = SideKind::kSeam;
       m.position = *seam;
     } else {
@@ -269,7 +264,8 @@ bool ShadowedByOccluder(const DepthImage& depth, const Eigen::Vector3d& side_cen
       const Eigen::Vector3d q = start + d * across;
       if (q.z() <= 0.05) break;
       const Eigen::Vector2d px = Project(depth.camera, q);
-      const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+      const int u = static_cast<int>(std::lround(px.x())),
+                v = static_cast<int>(std::lround(px.y()));
       if (!depth.inside(u, v)) break;
       const float z = depth.at(u, v);
       if (std::isnan(z)) continue;
@@ -315,18 +311,15 @@ std::optional<double> DistanceToPlaneEnd(const DepthImage& depth, const Eigen::V
 // Distances from a side to where the face's plane ends beyond it, along
 // three lines across the side (a layer can be notched where boxes were
 // taken); nothing when any march leaves the image.
-std::optional<std::array<double, 3>> LayerRunsBeyond(const DepthImage& depth,
-                                                     const Eigen::Vector3d& side_centre,
-                                                     const Eigen::Vector3d& across,
-                                                     const Eigen::Vector3d& along,
-                                                     double half_along,
-                                                     const Eigen::Vector3d& normal,
-                                                     const RefinementOptions& o) {
+std::optional<std::array<double, 3>> LayerRunsBeyond(
+    const DepthImage& depth, const Eigen::Vector3d& side_centre, const Eigen::Vector3d& across,
+    const Eigen::Vector3d& along, double half_along, const Eigen::Vector3d& normal,
+    const RefinementOptions& o) {
   std::array<double, 3> runs;
   const double offsets[3] = {-0.6, 0.0, 0.6};
   for (int i = 0; i < 3; ++i) {
-    const std::optional<double> d = DistanceToPlaneEnd(
-        depth, side_centre + offsets[i] * half_along * along, across, normal, o);
+    const std::optional<double> d =
+        DistanceToPlaneEnd(depth, side_centre + offsets[i] * half_along * along, across, normal, o);
     if (!d) return std::nullopt;
     runs[i] = *d;
   }
@@ -351,9 +344,8 @@ absl::Status RefinementOptions::Validate() const {
       !(free_side_ratio >= 0.0 && free_side_ratio <= 1.0) || iterations < 0 || iterations > 20 ||
       !(max_shift_m > 0.0) || !(max_turn_deg > 0.0)) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "refinement options out of range: plane_tolerance_m=", plane_tolerance_m,
-        " side_band_m=", side_band_m, " free_side_ratio=", free_side_ratio,
-        " iterations=", iterations));
+        "refinement options out of range: plane_tolerance_m=", plane_tolerance_m, " side_band_m=",
+        side_band_m, " free_side_ratio=", free_side_ratio, " iterations=", iterations));
   }
   return absl::OkStatus();
 }
@@ -367,8 +359,8 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
   for (int it = 0; it < std::max(1, options.iterations); ++it) {
     FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
     std::vector<FacePoint> front, grid;
-    const std::vector<FacePoint> pts = CollectFacePoints(depth, f, options.side_band_m,
-                                                         options.plane_tolerance_m, &front, &grid);
+    const std::vector<FacePoint> pts =
+        CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m, &front, &grid);
     const double pixel_m = f.c.z() / depth.camera.fx;  // point spacing on the face
     // Plane through the interior points.
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -393,10 +385,14 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     result.face_points = n;
 
     // Sides: +a, -a, +b, -b.
-    const SideMeasure pa = MeasureSide(pts, front, grid, true, 1.0, f.half_a, f.half_b, pixel_m, options);
-    const SideMeasure ma = MeasureSide(pts, front, grid, true, -1.0, f.half_a, f.half_b, pixel_m, options);
-    const SideMeasure pb = MeasureSide(pts, front, grid, false, 1.0, f.half_b, f.half_a, pixel_m, options);
-    const SideMeasure mb = MeasureSide(pts, front, grid, false, -1.0, f.half_b, f.half_a, pixel_m, options);
+    const SideMeasure pa =
+        MeasureSide(pts, front, grid, true, 1.0, f.half_a, f.half_b, pixel_m, options);
+    const SideMeasure ma =
+        MeasureSide(pts, front, grid, true, -1.0, f.half_a, f.half_b, pixel_m, options);
+    const SideMeasure pb =
+        MeasureSide(pts, front, grid, false, 1.0, f.half_b, f.half_a, pixel_m, options);
+    const SideMeasure mb =
+        MeasureSide(pts, front, grid, false, -1.0, f.half_b, f.half_a, pixel_m, options);
     result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
     result.free_sides = 0;
     for (SideKind k : result.sides) result.free_sides += k == SideKind::kFree;
@@ -469,8 +465,8 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     const Eigen::Vector3d axis_dir[2] = {f.a, f.b};
     const double size[2] = {2 * f.half_a, 2 * f.half_b};
     // Per axis, the run of the plane through the box along three lines.
-    std::array<std::array<double, 3>, 2> extent = {{{size[0], size[0], size[0]},
-                                                    {size[1], size[1], size[1]}}};
+    std::array<std::array<double, 3>, 2> extent = {
+        {{size[0], size[0], size[0]}, {size[1], size[1], size[1]}}};
     bool measured = true;
     for (int ax = 0; ax < 2 && measured; ++ax) {
       for (int sgn = 0; sgn < 2 && measured; ++sgn) {
@@ -519,8 +515,8 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     }
   }
   const double shift = (pose.translation() - initial.translation()).norm();
-  const double turn_deg =
-      Eigen::AngleAxisd(initial.linear().transpose() * pose.linear()).angle() * 180.0 / std::numbers::pi;
+  const double turn_deg = Eigen::AngleAxisd(initial.linear().transpose() * pose.linear()).angle() *
+                          180.0 / std::numbers::pi;
   if (shift > options.max_shift_m || turn_deg > options.max_turn_deg) return result;
   *camera_T_box = pose;
   result.ok = true;

@@ -66,8 +66,8 @@ enum class SideKind : uint8_t {
 struct RefinementResult {
   std::array<SideKind, 4> sides{};  // +a, -a, +b, -b of the grasp face
   bool ok = false;
-  int free_sides = 0;     // of the grasp face's four
-  int face_points = 0;    // points on the grasp face
+  int free_sides = 0;   // of the grasp face's four
+  int face_points = 0;  // points on the grasp face
   double plane_rms_m = 0.0;
   // Measured extent of the face between two free sides along its two axes,
   // or 0 where a side is not free. Metres.

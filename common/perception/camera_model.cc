@@ -1,5 +1,6 @@
 #include "common/perception/camera_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -44,6 +45,23 @@ absl::StatusOr<CameraIntrinsics> EstimateIntrinsics(const PointCloud& cloud) {
         absl::StrCat("too few valid points (", n, ") to recover the camera intrinsics"));
   }
   return k;
+}
+
+std::optional<PixelRect> ProjectedRect(const CameraIntrinsics& k,
+                                       const std::vector<Eigen::Vector3d>& points) {
+  double u0 = std::numeric_limits<double>::max(), v0 = u0, u1 = -u0, v1 = -u0;
+  for (const Eigen::Vector3d& p : points) {
+    if (p.z() <= 0.05) return std::nullopt;
+    const Eigen::Vector2d px = Project(k, p);
+    u0 = std::min(u0, px.x()), u1 = std::max(u1, px.x());
+    v0 = std::min(v0, px.y()), v1 = std::max(v1, px.y());
+  }
+  PixelRect r{std::max(0, static_cast<int>(std::floor(u0))),
+              std::max(0, static_cast<int>(std::floor(v0))),
+              std::min(k.width - 1, static_cast<int>(std::ceil(u1))),
+              std::min(k.height - 1, static_cast<int>(std::ceil(v1)))};
+  if (r.u0 > r.u1 || r.v0 > r.v1) return std::nullopt;
+  return r;
 }
 
 DepthImage MakeDepthImage(const PointCloud& cloud, const CameraIntrinsics& k) {

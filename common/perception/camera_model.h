@@ -2,6 +2,9 @@
 // used to project hypotheses back into the image.
 #pragma once
 
+#include <optional>
+#include <vector>
+
 #include "absl/status/statusor.h"
 #include "common/perception/types.h"
 
@@ -22,6 +25,16 @@ inline Eigen::Vector2d Project(const CameraIntrinsics& k, const Eigen::Vector3d&
 inline Eigen::Vector3d PixelRay(const CameraIntrinsics& k, double u, double v) {
   return {(u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0};
 }
+
+// The pixel rectangle (clipped to the image) that covers the projections of
+// some camera-frame points; nothing when a point is not in front of the
+// camera (z <= 5 cm) or the rectangle misses the image.
+struct PixelRect {
+  int u0, v0, u1, v1;  // inclusive
+  double area() const { return static_cast<double>(u1 - u0 + 1) * (v1 - v0 + 1); }
+};
+std::optional<PixelRect> ProjectedRect(const CameraIntrinsics& k,
+                                       const std::vector<Eigen::Vector3d>& points);
 
 // An organized depth image of a cloud: for an organized cloud its z values;
 // for an unorganized one a z-buffer of its points projected through `k`

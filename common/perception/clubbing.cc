@@ -52,8 +52,10 @@ bool SegmentsMeet(const std::vector<EdgeSegment>& segments, int a, int b,
   const Eigen::Vector3d qa = pa + ta * da, qb = pb + tb * db;
   if ((qa - qb).norm() > options.meet_distance_m) return false;
   const Eigen::Vector3d meet = 0.5 * (qa + qb);
-  const double a1 = (sa.end1.cast<double>() - meet).norm(), a2 = (sa.end2.cast<double>() - meet).norm();
-  const double b1 = (sb.end1.cast<double>() - meet).norm(), b2 = (sb.end2.cast<double>() - meet).norm();
+  const double a1 = (sa.end1.cast<double>() - meet).norm(),
+               a2 = (sa.end2.cast<double>() - meet).norm();
+  const double b1 = (sb.end1.cast<double>() - meet).norm(),
+               b2 = (sb.end2.cast<double>() - meet).norm();
   if (std::min(a1, a2) > options.end_gap_m || std::min(b1, b2) > options.end_gap_m) return false;
   corner->position = meet.cast<float>();
   corner->segment_a = a;

@@ -128,7 +128,8 @@ class OrganizedScorer {
   }
 
  private:
-  static bool NearMark(const std::vector<uint8_t>& marks, int cu, int cv, int cells_w, int cells_h) {
+  static bool NearMark(const std::vector<uint8_t>& marks, int cu, int cv, int cells_w,
+                       int cells_h) {
     for (int y = std::max(0, cv - 1); y <= std::min(cells_h - 1, cv + 1); ++y) {
       for (int x = std::max(0, cu - 1); x <= std::min(cells_w - 1, cu + 1); ++x) {
         if (marks[y * cells_w + x]) return true;
@@ -315,8 +316,8 @@ absl::Status EdgePointOptions::Validate() const {
         absl::StrCat("edge min_neighbours=", min_neighbours, " is outside [1, 1000]"));
   }
   if (!(occluded_side_jump_m >= 0.0 && occluded_side_jump_m <= 1.0)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "edge occluded_side_jump_m=", occluded_side_jump_m, " is outside [0, 1] m"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("edge occluded_side_jump_m=", occluded_side_jump_m, " is outside [0, 1] m"));
   }
   if (coarse_step < 1 || coarse_step > 16) {
     return absl::InvalidArgumentError(
@@ -342,8 +343,8 @@ float EdgeScore(const Eigen::Vector3f& p, const std::vector<Eigen::Vector3f>& ne
   return sum.Score();
 }
 
-absl::StatusOr<EdgePoints> DetectEdgePoints(const PointCloud& cloud, const EdgePointOptions& options,
-                                            double focal_px) {
+absl::StatusOr<EdgePoints> DetectEdgePoints(const PointCloud& cloud,
+                                            const EdgePointOptions& options, double focal_px) {
   if (absl::Status s = options.Validate(); !s.ok()) return s;
   if (absl::Status s = cloud.Validate(); !s.ok()) return s;
   if (cloud.organized()) {

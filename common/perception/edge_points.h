@@ -61,7 +61,8 @@ float EdgeScore(const Eigen::Vector3f& p, const std::vector<Eigen::Vector3f>& ne
 // pixel grid for neighbour search and need the camera's focal length (pixels),
 // which EstimateIntrinsics() can recover from the cloud itself; unorganized
 // clouds use a k-d tree over all neighbours within r_s, as in the paper.
-absl::StatusOr<EdgePoints> DetectEdgePoints(const PointCloud& cloud, const EdgePointOptions& options,
+absl::StatusOr<EdgePoints> DetectEdgePoints(const PointCloud& cloud,
+                                            const EdgePointOptions& options,
                                             double focal_px = 525.0);
 
 }  // namespace cornerpose

@@ -1,5 +1,6 @@
 #include "common/perception/edge_segments.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,8 +8,6 @@
 #include <optional>
 #include <random>
 #include <unordered_map>
-
-#include <Eigen/Eigenvalues>
 
 #include "absl/strings/str_cat.h"
 
@@ -136,7 +135,8 @@ class SegmentFitter {
         if (d2 >= min2 && d2 <= max2) candidates.push_back(i);
       });
       if (candidates.empty()) continue;
-      const int b = candidates[std::uniform_int_distribution<size_t>(0, candidates.size() - 1)(rng_)];
+      const int b =
+          candidates[std::uniform_int_distribution<size_t>(0, candidates.size() - 1)(rng_)];
       Line line;
       line.point = pts_[a];
       line.direction = (pts_[b] - pts_[a]).normalized();
@@ -267,17 +267,16 @@ absl::Status EdgeSegmentOptions::Validate() const {
     }
     return absl::OkStatus();
   };
-  for (absl::Status s : {range("ransac_threshold_m", ransac_threshold_m, 1e-4, 0.2),
-                         range("gap_m", gap_m, 1e-4, 0.5),
-                         range("ransac_iterations", ransac_iterations, 1, 100000),
-                         range("ransac_subset", ransac_subset, 10, 10000000),
-                         range("sample_min_m", sample_min_m, 0.0, 1.0),
-                         range("sample_max_m", sample_max_m, sample_min_m + 1e-4, 2.0),
-                         range("min_points", min_points, 2, 1000000),
-                         range("min_length_m", min_length_m, 0.0, 10.0),
-                         range("removal_scale", removal_scale, 1.0, 10.0),
-                         range("max_segments", max_segments, 1, 100000),
-                         range("max_failures", max_failures, 1, 100000)}) {
+  for (absl::Status s :
+       {range("ransac_threshold_m", ransac_threshold_m, 1e-4, 0.2),
+        range("gap_m", gap_m, 1e-4, 0.5), range("ransac_iterations", ransac_iterations, 1, 100000),
+        range("ransac_subset", ransac_subset, 10, 10000000),
+        range("sample_min_m", sample_min_m, 0.0, 1.0),
+        range("sample_max_m", sample_max_m, sample_min_m + 1e-4, 2.0),
+        range("min_points", min_points, 2, 1000000), range("min_length_m", min_length_m, 0.0, 10.0),
+        range("removal_scale", removal_scale, 1.0, 10.0),
+        range("max_segments", max_segments, 1, 100000),
+        range("max_failures", max_failures, 1, 100000)}) {
     if (!s.ok()) return s;
   }
   return absl::OkStatus();

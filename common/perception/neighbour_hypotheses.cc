@@ -13,7 +13,8 @@ std::vector<Eigen::Isometry3d> NeighbourHypotheses(const DetectedBox& box, const
   const Eigen::Vector3d t = box.camera_T_box.translation();
   // The same box turned a quarter about the face normal: its a and b sides
   // swap.
-  Eigen::Matrix3d R_turned = R * Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::Unit(axis_n)).toRotationMatrix();
+  Eigen::Matrix3d R_turned =
+      R * Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::Unit(axis_n)).toRotationMatrix();
   std::vector<Eigen::Isometry3d> out;
   auto add = [&](const Eigen::Matrix3d& rot, const Eigen::Vector3d& centre) {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();

@@ -14,8 +14,8 @@ absl::Status PointCloud::Validate() const {
         absl::StrCat("cloud size ", width, " x ", height, ": one side is zero"));
   }
   if (static_cast<size_t>(width) * static_cast<size_t>(height) != xyz.size()) {
-    return absl::InvalidArgumentError(absl::StrCat("cloud is ", width, " x ", height, " but holds ",
-                                                   xyz.size(), " points"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("cloud is ", width, " x ", height, " but holds ", xyz.size(), " points"));
   }
   return absl::OkStatus();
 }

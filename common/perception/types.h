@@ -2,14 +2,13 @@
 // this header is included everywhere, so it stays light.
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 
 #include "absl/status/status.h"
 
@@ -70,11 +69,11 @@ Eigen::Vector3d BoxFaceNormal(BoxFace face);
 
 // An edge segment found in the edge points: two extremities and its support.
 struct EdgeSegment {
-  Eigen::Vector3f end1 = Eigen::Vector3f::Zero();  // camera frame, m
-  Eigen::Vector3f end2 = Eigen::Vector3f::Zero();  // camera frame, m
-  Eigen::Vector3f point = Eigen::Vector3f::Zero();      // a point on the fitted line, m
+  Eigen::Vector3f end1 = Eigen::Vector3f::Zero();        // camera frame, m
+  Eigen::Vector3f end2 = Eigen::Vector3f::Zero();        // camera frame, m
+  Eigen::Vector3f point = Eigen::Vector3f::Zero();       // a point on the fitted line, m
   Eigen::Vector3f direction = Eigen::Vector3f::UnitX();  // unit, end1 -> end2
-  int num_points = 0;                                   // edge points assigned to it
+  int num_points = 0;                                    // edge points assigned to it
 
   float length() const { return (end2 - end1).norm(); }
 };
@@ -82,7 +81,7 @@ struct EdgeSegment {
 // Where two perpendicular edge segments meet.
 struct Corner {
   Eigen::Vector3f position = Eigen::Vector3f::Zero();  // camera frame, m
-  int segment_a = -1;  // index into the segment list
+  int segment_a = -1;                                  // index into the segment list
   int segment_b = -1;
   bool a_at_end1 = true;  // which extremity of segment_a meets
   bool b_at_end1 = true;
@@ -94,7 +93,7 @@ struct DetectedBox {
   // Confidence in [0, 1]: the share of the box's expected visible surface
   // that the cloud confirms, lowered by contradicting evidence.
   double score = 0.0;
-  BoxFace grasp_face = BoxFace::kPlusZ;           // the face that looks at the camera
+  BoxFace grasp_face = BoxFace::kPlusZ;  // the face that looks at the camera
   Eigen::Vector3d grasp_centre_camera = Eigen::Vector3d::Zero();  // its centre, m
   Eigen::Vector3d grasp_normal_camera = Eigen::Vector3d::Zero();  // its outward normal
   std::vector<int> segments;  // edge segments that support the box

@@ -59,8 +59,8 @@ DetectorOptions Options(bool reference, int threads) {
   o.box = TheFrame().dims;
   o.num_threads = threads;
   if (reference) {
-    o.edge_points.coarse_step = 1;   // score every pixel
-    o.edge_points.max_samples = 0;   // every neighbour in the disc
+    o.edge_points.coarse_step = 1;  // score every pixel
+    o.edge_points.max_samples = 0;  // every neighbour in the disc
   }
   return o;
 }
