@@ -1,0 +1,69 @@
+#include "server/server.h"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/security/server_credentials.h>
+#include <grpcpp/server_builder.h>
+
+#include <mutex>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace cornerpose::server {
+
+RunningServer::RunningServer(std::unique_ptr<DetectionPool> pool,
+                             std::unique_ptr<PerceptionServiceImpl> service,
+                             std::unique_ptr<grpc::Server> server, int port)
+    : pool_(std::move(pool)),
+      service_(std::move(service)),
+      server_(std::move(server)),
+      port_(port) {}
+
+RunningServer::~RunningServer() { Shutdown(); }
+
+void RunningServer::Shutdown() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  server_->Shutdown();
+}
+
+void RunningServer::Wait() { server_->Wait(); }
+
+absl::StatusOr<std::unique_ptr<RunningServer>> StartServer(const ServerOptions& options) {
+  if (options.max_message_bytes <= 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_message_bytes ", options.max_message_bytes, " must be > 0"));
+  }
+  if (options.max_concurrent_detections < 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "max_concurrent_detections ", options.max_concurrent_detections, " must be >= 1"));
+  }
+
+  // Both are process-wide switches read when a ServerBuilder is made.
+  static std::once_flag once;
+  std::call_once(once, [] {
+    grpc::EnableDefaultHealthCheckService(true);
+    grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  });
+
+  auto pool = std::make_unique<DetectionPool>(options.max_concurrent_detections);
+  auto service = std::make_unique<PerceptionServiceImpl>(pool.get(), DetectorOptions{});
+
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort(options.listen_address, grpc::InsecureServerCredentials(), &port);
+  builder.SetMaxReceiveMessageSize(options.max_message_bytes);
+  builder.SetMaxSendMessageSize(options.max_message_bytes);
+  builder.RegisterService(service.get());
+  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  if (server == nullptr || port == 0) {
+    if (server != nullptr) server->Shutdown();
+    return absl::UnavailableError(absl::StrCat("could not listen on '", options.listen_address,
+                                               "' (address in use or malformed?)"));
+  }
+  return std::make_unique<RunningServer>(std::move(pool), std::move(service), std::move(server),
+                                         port);
+}
+
+}  // namespace cornerpose::server

@@ -1,0 +1,72 @@
+// cornerpose_server: the perception service over gRPC.
+//
+//   cornerpose_server --listen 0.0.0.0:50051 --max_message_bytes 67108864
+//
+// Runs until SIGINT or SIGTERM, then finishes the RPCs in flight and exits.
+#include <semaphore.h>
+
+#include <cerrno>
+#include <csignal>
+#include <iostream>
+#include <string>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "server/server.h"
+#include "server/server_options.h"
+
+ABSL_FLAG(std::string, listen, cornerpose::server::ServerOptions{}.listen_address,
+          "host:port to listen on (port 0 picks a free one)");
+ABSL_FLAG(int, max_message_bytes, cornerpose::server::ServerOptions{}.max_message_bytes,
+          "largest request or response, bytes");
+ABSL_FLAG(int, max_concurrent_detections,
+          cornerpose::server::ServerOptions{}.max_concurrent_detections,
+          "detections run at once; more wait in a queue");
+
+namespace {
+
+// Posted by the stop signals. gRPC starts threads before main (static
+// initializers), so sigwait on a blocked mask would miss signals delivered
+// to them; a handler runs whichever thread takes the signal, and sem_post is
+// async-signal-safe.
+sem_t stop_requested;
+volatile std::sig_atomic_t stop_signal = 0;
+
+void OnStopSignal(int signal) {
+  stop_signal = signal;
+  sem_post(&stop_requested);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  absl::SetProgramUsageMessage("Serves cornerpose.v1.PerceptionService over gRPC.");
+  absl::ParseCommandLine(argc, argv);
+
+  sem_init(&stop_requested, /*pshared=*/0, /*value=*/0);
+  struct sigaction action = {};
+  action.sa_handler = OnStopSignal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+
+  cornerpose::server::ServerOptions options;
+  options.listen_address = absl::GetFlag(FLAGS_listen);
+  options.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
+  options.max_concurrent_detections = absl::GetFlag(FLAGS_max_concurrent_detections);
+
+  auto server = cornerpose::server::StartServer(options);
+  if (!server.ok()) {
+    std::cerr << "cornerpose_server: " << server.status() << "\n";
+    return 1;
+  }
+  std::cerr << "cornerpose_server: listening on " << options.listen_address << " (port "
+            << (*server)->port() << ")" << std::endl;
+
+  while (sem_wait(&stop_requested) != 0 && errno == EINTR) {
+  }
+  std::cerr << "cornerpose_server: signal " << stop_signal << ", shutting down" << std::endl;
+  (*server)->Shutdown();
+  return 0;
+}

@@ -1,0 +1,19 @@
+// What a cornerpose server is started with.
+#pragma once
+
+#include <string>
+
+namespace cornerpose::server {
+
+struct ServerOptions {
+  // host:port to listen on; port 0 picks a free port (tests).
+  std::string listen_address = "0.0.0.0:50051";
+  // Largest request or response, bytes. A VGA cloud is 3.7 MB, above gRPC's
+  // 4 MiB default once framed, so the default leaves room for larger frames.
+  int max_message_bytes = 64 * 1024 * 1024;
+  // Detections run at once; more wait in a queue. Each uses the detector's
+  // worker threads, so this times num_threads should not exceed the cores.
+  int max_concurrent_detections = 2;
+};
+
+}  // namespace cornerpose::server

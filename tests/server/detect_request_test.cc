@@ -1,0 +1,113 @@
+#include "server/detect_request.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace cornerpose::server {
+namespace {
+
+using ::testing::HasSubstr;
+
+v1::DetectRequest WithBox(double l, double b, double h) {
+  v1::DetectRequest request;
+  request.mutable_box()->set_l(l);
+  request.mutable_box()->set_b(b);
+  request.mutable_box()->set_h(h);
+  return request;
+}
+
+TEST(DetectorOptionsFromRequestTest, ExplicitBoxAndOverrides) {
+  v1::DetectRequest request = WithBox(0.3, 0.2, 0.15);
+  request.mutable_overrides()->set_edge_radius_m(0.03);
+  request.mutable_overrides()->set_edge_threshold(0.4);
+  request.mutable_overrides()->set_ransac_threshold_m(0.005);
+  absl::StatusOr<DetectorOptions> options = DetectorOptionsFromRequest(request, {});
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(options->box.l, 0.3);
+  EXPECT_EQ(options->box.h, 0.15);
+  EXPECT_EQ(options->edge_points.radius_m, 0.03);
+  EXPECT_EQ(options->segments.gap_m, 0.03);
+  EXPECT_EQ(options->edge_points.threshold, 0.4);
+  EXPECT_EQ(options->segments.ransac_threshold_m, 0.005);
+}
+
+TEST(DetectorOptionsFromRequestTest, UnsetOverridesKeepDefaults) {
+  DetectorOptions defaults;
+  defaults.edge_points.threshold = 0.31;
+  absl::StatusOr<DetectorOptions> options =
+      DetectorOptionsFromRequest(WithBox(0.3, 0.2, 0.15), defaults);
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(options->edge_points.threshold, 0.31);
+}
+
+TEST(DetectorOptionsFromRequestTest, ModelName) {
+  v1::DetectRequest request;
+  request.set_box_model("carton_l");
+  absl::StatusOr<DetectorOptions> options = DetectorOptionsFromRequest(request, {});
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(options->box.l, 0.40);
+  EXPECT_EQ(options->box.b, 0.30);
+  EXPECT_EQ(options->box.h, 0.25);
+}
+
+TEST(DetectorOptionsFromRequestTest, RefusedBoxes) {
+  struct Case {
+    v1::DetectRequest request;
+    std::string message;
+  };
+  v1::DetectRequest unknown;
+  unknown.set_box_model("crate");
+  const Case cases[] = {
+      {WithBox(0.3, 0.0, 0.15), "box size b=0 m must be positive"},
+      {WithBox(-0.3, 0.2, 0.15), "box size l=-0.3 m must be positive"},
+      {WithBox(0.3, 0.2, 11), "above the 10 m limit"},
+      {unknown, "unknown box model 'crate'"},
+      {v1::DetectRequest(), "request has no box size"},
+  };
+  for (const Case& c : cases) {
+    absl::Status s = DetectorOptionsFromRequest(c.request, {}).status();
+    EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << c.message;
+    EXPECT_THAT(s.message(), HasSubstr(c.message));
+  }
+}
+
+TEST(DetectorOptionsFromRequestTest, OutOfRangeOverrideIsInvalid) {
+  v1::DetectRequest request = WithBox(0.3, 0.2, 0.15);
+  request.mutable_overrides()->set_edge_radius_m(-1.0);
+  EXPECT_EQ(DetectorOptionsFromRequest(request, {}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+TEST(CloudFromRequestTest, SourceIsNotFoundAndNoInputIsInvalid) {
+  v1::DetectRequest request;
+  request.set_source("cell_1");
+  absl::Status s = CloudFromRequest(request).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(s.message(), "unknown source 'cell_1'");
+
+  s = CloudFromRequest(v1::DetectRequest()).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("request has no input"));
+}
+
+TEST(CloudFromRequestTest, DepthImageUsesRequestIntrinsics) {
+  v1::DetectRequest request;
+  v1::DepthImage* image = request.mutable_depth_image();
+  image->set_width(1);
+  image->set_height(1);
+  image->set_encoding(v1::DEPTH_ENCODING_UINT16_MM);
+  image->set_data(std::string("\xe8\x03", 2));  // 1000 mm
+  EXPECT_EQ(CloudFromRequest(request).status().code(), absl::StatusCode::kInvalidArgument);
+
+  request.mutable_intrinsics()->set_width(1);
+  request.mutable_intrinsics()->set_height(1);
+  request.mutable_intrinsics()->set_fx(500);
+  request.mutable_intrinsics()->set_fy(500);
+  absl::StatusOr<PointCloud> cloud = CloudFromRequest(request);
+  ASSERT_TRUE(cloud.ok()) << cloud.status();
+  ASSERT_EQ(cloud->size(), 1u);
+  EXPECT_FLOAT_EQ(cloud->xyz[0].z(), 1.0f);
+}
+
+}  // namespace
+}  // namespace cornerpose::server
