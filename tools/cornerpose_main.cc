@@ -1,12 +1,14 @@
 // cornerpose: the command-line tool.
 //
 //   cornerpose detect --cloud FILE --box L,B,H|NAME --json OUT [--ply OUT] [--png OUT] ...
+//   cornerpose client detect --server ADDR --cloud FILE --box L,B,H|NAME [--json OUT] ...
 //
 // Run `cornerpose detect --help` for every option.
 #include <cstdio>
 #include <string>
 #include <vector>
 
+#include "tools/client_command.h"
 #include "tools/detect_command.h"
 
 namespace {
@@ -15,6 +17,7 @@ constexpr char kUsage[] =
     "usage: cornerpose <command> [options]\n"
     "commands:\n"
     "  detect   find edges, corners and box poses in a point cloud file\n"
+    "  client   send a point cloud file to a cornerpose server ('client detect')\n"
     "run 'cornerpose <command> --help' for the options of a command\n";
 
 }  // namespace
@@ -27,6 +30,7 @@ int main(int argc, char** argv) {
   const std::string command = argv[1];
   std::vector<std::string> args(argv + 2, argv + argc);
   if (command == "detect") return cornerpose::tools::RunDetect(args);
+  if (command == "client") return cornerpose::tools::RunClient(args);
   if (command == "--help" || command == "-h" || command == "help") {
     std::fputs(kUsage, stdout);
     return 0;

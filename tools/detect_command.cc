@@ -174,21 +174,7 @@ absl::Status Run(const Args& args) {
   absl::StatusOr<Detection> det = DetectBoxes(*cloud, options);
   if (!det.ok()) return det.status();
 
-  if (!args.quiet) {
-    std::printf("%s: %zu points, %zu edge points, %zu segments, %zu corners, %zu boxes (%.1f ms)\n",
-                get("cloud")->c_str(), cloud->size(), det->edge_points.size(), det->segments.size(),
-                det->corners.size(), det->boxes.size(), det->timings.total_ms);
-    for (size_t i = 0; i < det->boxes.size(); ++i) {
-      const DetectedBox& b = det->boxes[i];
-      const Eigen::Vector3d t = b.camera_T_box.translation();
-      const Eigen::Vector3d ypr = b.camera_T_box.linear().eulerAngles(2, 1, 0) * 180.0 / M_PI;
-      std::printf(
-          "  box %zu: score %.2f  centre (%.3f, %.3f, %.3f) m  zyx euler (%.1f, %.1f, %.1f) deg"
-          "  grasp %s at (%.3f, %.3f, %.3f)\n",
-          i, b.score, t.x(), t.y(), t.z(), ypr.x(), ypr.y(), ypr.z(), BoxFaceName(b.grasp_face),
-          b.grasp_centre_camera.x(), b.grasp_centre_camera.y(), b.grasp_centre_camera.z());
-    }
-  }
+  if (!args.quiet) PrintDetection(*get("cloud"), cloud->size(), *det);
   if (auto p = get("json")) {
     if (absl::Status s = WriteDetectionJson(*p, *det, *box); !s.ok()) return s;
   }
@@ -209,6 +195,23 @@ absl::Status Run(const Args& args) {
 }
 
 }  // namespace
+
+void PrintDetection(const std::string& label, size_t num_points, const Detection& detection) {
+  const Detection* det = &detection;
+  std::printf("%s: %zu points, %zu edge points, %zu segments, %zu corners, %zu boxes (%.1f ms)\n",
+              label.c_str(), num_points, det->edge_points.size(), det->segments.size(),
+              det->corners.size(), det->boxes.size(), det->timings.total_ms);
+  for (size_t i = 0; i < det->boxes.size(); ++i) {
+    const DetectedBox& b = det->boxes[i];
+    const Eigen::Vector3d t = b.camera_T_box.translation();
+    const Eigen::Vector3d ypr = b.camera_T_box.linear().eulerAngles(2, 1, 0) * 180.0 / M_PI;
+    std::printf(
+        "  box %zu: score %.2f  centre (%.3f, %.3f, %.3f) m  zyx euler (%.1f, %.1f, %.1f) deg"
+        "  grasp %s at (%.3f, %.3f, %.3f)\n",
+        i, b.score, t.x(), t.y(), t.z(), ypr.x(), ypr.y(), ypr.z(), BoxFaceName(b.grasp_face),
+        b.grasp_centre_camera.x(), b.grasp_centre_camera.y(), b.grasp_centre_camera.z());
+  }
+}
 
 int RunDetect(const std::vector<std::string>& argv) {
   for (const std::string& a : argv) {

@@ -5,9 +5,15 @@
 #include <string>
 #include <vector>
 
+#include "common/perception/types.h"
+
 namespace cornerpose::tools {
 
 // argv holds the arguments after "detect". Returns the process exit code.
 int RunDetect(const std::vector<std::string>& args);
+
+// Prints the summary line ("<label>: N points, ... boxes (T ms)") and one
+// line per box, as `cornerpose detect` does (shared with `cornerpose client`).
+void PrintDetection(const std::string& label, size_t num_points, const Detection& detection);
 
 }  // namespace cornerpose::tools

@@ -1,0 +1,28 @@
+// The client side of the wire format: a cloud packed into a request, and a
+// DetectResponse converted back into the detector's types. server/conversion.h
+// goes the other way (proto -> cloud, Detection -> proto).
+#pragma once
+
+#include "absl/status/statusor.h"
+#include "common/perception/types.h"
+#include "cornerpose/v1/geometry.pb.h"
+#include "cornerpose/v1/perception_service.pb.h"
+
+namespace cornerpose::tools {
+
+// Packs xyz as little-endian float32 triples, keeping width x height (and
+// the NaNs of an organized cloud). The inverse of server::CloudFromProto.
+v1::PointCloud CloudToProto(const PointCloud& cloud);
+
+// The inverse of server::ToProto(BoxFace). INVALID_ARGUMENT for
+// BOX_FACE_UNSPECIFIED or an unknown value.
+absl::StatusOr<BoxFace> BoxFaceFromProto(v1::BoxFace face);
+
+// Boxes (pose from position + unit quaternion), segments (the line point and
+// direction rebuilt from the extremities), corners (without the segment
+// indices, which the wire does not carry), edge points (when the response has
+// them) and timings. INVALID_ARGUMENT for a box with a zero quaternion or an
+// unspecified grasp face.
+absl::StatusOr<Detection> DetectionFromProto(const v1::DetectResponse& response);
+
+}  // namespace cornerpose::tools
