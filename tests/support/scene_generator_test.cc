@@ -248,17 +248,17 @@ TEST(SceneGeneratorTest, PalletGridWithRemovedTopBoxes) {
   EXPECT_GT(support_px, 0);
 }
 
-TEST(SceneGeneratorTest, HeapOfFifteenRendersQuickly) {
+// Speed is not asserted here (machines are noisy); the time is printed for
+// the record.
+TEST(SceneGeneratorTest, HeapOfFifteenRendersMostPixels) {
   const Scene scene = MakeHeapScene(kCartonS, 15, 11);
   const auto start = std::chrono::steady_clock::now();
   const RenderedScene out = Render(scene, NoiseOptions{});
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::printf("15-box heap render: %.1f ms, %d valid px\n", ms, out.stats.valid);
+  EXPECT_EQ(out.boxes.size(), 15u);
   EXPECT_GT(out.stats.valid, 0.5 * out.cloud.size());
-#ifdef NDEBUG
-  EXPECT_LT(ms, 1000.0);
-#endif
 }
 
 }  // namespace
