@@ -22,6 +22,7 @@
 #include "common/viz/detection_png.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "tools/client/response_conversion.h"
+#include "tools/command_args.h"
 #include "tools/detect_command.h"
 
 namespace cornerpose::tools {
@@ -54,50 +55,8 @@ constexpr char kHelp[] =
     "Edge points are only requested from the server when --ply, --png or --edges\n"
     "needs them (otherwise the printed and JSON edge point count is 0).\n";
 
-struct Args {
-  std::map<std::string, std::string> values;
-  bool quiet = false;
-};
-
-absl::StatusOr<Args> ParseArgs(const std::vector<std::string>& args) {
-  static const char* kKnown[] = {"server", "cloud", "box",   "intrinsics", "json",
-                                 "ply",    "png",   "edges", "deadline_ms"};
-  Args out;
-  for (size_t i = 0; i < args.size(); ++i) {
-    std::string a = args[i];
-    if (a == "--quiet") {
-      out.quiet = true;
-      continue;
-    }
-    if (a.rfind("--", 0) != 0)
-      return absl::InvalidArgumentError(absl::StrCat("unexpected argument '", a, "'"));
-    a = a.substr(2);
-    std::string value;
-    if (const size_t eq = a.find('='); eq != std::string::npos) {
-      value = a.substr(eq + 1);
-      a = a.substr(0, eq);
-    } else if (i + 1 < args.size()) {
-      value = args[++i];
-    } else {
-      return absl::InvalidArgumentError(absl::StrCat("option --", a, " needs a value"));
-    }
-    bool known = false;
-    for (const char* k : kKnown) known |= a == k;
-    if (!known) return absl::InvalidArgumentError(absl::StrCat("unknown option --", a));
-    out.values[a] = value;
-  }
-  for (const char* required : {"server", "cloud", "box"}) {
-    if (!out.values.count(required))
-      return absl::InvalidArgumentError(absl::StrCat("--", required, " is required"));
-  }
-  return out;
-}
-
-absl::Status Detect(const Args& args) {
-  auto get = [&](const std::string& k) -> std::optional<std::string> {
-    auto it = args.values.find(k);
-    return it == args.values.end() ? std::nullopt : std::optional<std::string>(it->second);
-  };
+absl::Status Detect(const CommandArgs& args) {
+  auto get = [&](const std::string& k) { return args.Get(k); };
   const std::string server = *get("server");
   const std::string box_text = *get("box");
   absl::StatusOr<BoxDims> box = ParseBoxDims(box_text);
@@ -167,7 +126,7 @@ absl::Status Detect(const Args& args) {
         absl::StrCat("bad response from ", server, ": ", det.status().message()));
   }
 
-  if (!args.quiet) PrintDetection(*get("cloud"), cloud->size(), *det);
+  if (!args.Has("quiet")) PrintDetection(*get("cloud"), cloud->size(), *det);
   if (auto p = get("json")) {
     if (absl::Status s = WriteDetectionJson(*p, *det, *box); !s.ok()) return s;
   }
@@ -194,15 +153,17 @@ int RunClientDetect(const std::vector<std::string>& argv) {
       return 0;
     }
   }
-  absl::StatusOr<Args> args = ParseArgs(argv);
+  absl::StatusOr<CommandArgs> args = ParseCommandArgs(
+      argv, {"server", "cloud", "box", "intrinsics", "json", "ply", "png", "edges", "deadline_ms"},
+      {"quiet"}, {"server", "cloud", "box"});
   if (!args.ok()) {
     std::fprintf(stderr, "cornerpose client: %s\n\n%s",
                  std::string(args.status().message()).c_str(), kHelp);
     return 2;
   }
   if (absl::Status s = Detect(*args); !s.ok()) {
-    std::fprintf(stderr, "cornerpose client: %s: %s\n",
-                 absl::StatusCodeToString(s.code()).c_str(), std::string(s.message()).c_str());
+    std::fprintf(stderr, "cornerpose client: %s: %s\n", absl::StatusCodeToString(s.code()).c_str(),
+                 std::string(s.message()).c_str());
     return 1;
   }
   return 0;

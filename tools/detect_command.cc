@@ -17,6 +17,7 @@
 #include "common/viz/detection_json.h"
 #include "common/viz/detection_ply.h"
 #include "common/viz/detection_png.h"
+#include "tools/command_args.h"
 
 namespace cornerpose::tools {
 namespace {
@@ -53,94 +54,8 @@ constexpr char kHelp[] =
     "                       paper's way) instead of projecting onto the camera grid\n"
     "  --quiet              print nothing but errors\n";
 
-struct Args {
-  std::map<std::string, std::string> values;
-  bool quiet = false;
-  bool kdtree = false;
-};
-
-absl::StatusOr<Args> ParseArgs(const std::vector<std::string>& args) {
-  static const char* kKnown[] = {"cloud",
-                                 "box",
-                                 "intrinsics",
-                                 "json",
-                                 "ply",
-                                 "png",
-                                 "edges",
-                                 "radius",
-                                 "threshold",
-                                 "samples",
-                                 "ransac_threshold",
-                                 "meet_distance",
-                                 "threads",
-                                 "coarse_step",
-                                 "denoise"};
-  Args out;
-  for (size_t i = 0; i < args.size(); ++i) {
-    std::string a = args[i];
-    if (a == "--quiet") {
-      out.quiet = true;
-      continue;
-    }
-    if (a == "--kdtree") {
-      out.kdtree = true;
-      continue;
-    }
-    if (a.rfind("--", 0) != 0)
-      return absl::InvalidArgumentError(absl::StrCat("unexpected argument '", a, "'"));
-    a = a.substr(2);
-    std::string value;
-    if (const size_t eq = a.find('='); eq != std::string::npos) {
-      value = a.substr(eq + 1);
-      a = a.substr(0, eq);
-    } else if (i + 1 < args.size()) {
-      value = args[++i];
-    } else {
-      return absl::InvalidArgumentError(absl::StrCat("option --", a, " needs a value"));
-    }
-    bool known = false;
-    for (const char* k : kKnown) known |= a == k;
-    if (!known) return absl::InvalidArgumentError(absl::StrCat("unknown option --", a));
-    out.values[a] = value;
-  }
-  return out;
-}
-
-absl::Status SetDouble(const Args& args, const std::string& key, double* out) {
-  auto it = args.values.find(key);
-  if (it == args.values.end()) return absl::OkStatus();
-  if (!absl::SimpleAtod(it->second, out)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--", key, " '", it->second, "' is not a number"));
-  }
-  return absl::OkStatus();
-}
-
-absl::Status SetInt(const Args& args, const std::string& key, int* out) {
-  auto it = args.values.find(key);
-  if (it == args.values.end()) return absl::OkStatus();
-  if (!absl::SimpleAtoi(it->second, out)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--", key, " '", it->second, "' is not an integer"));
-  }
-  return absl::OkStatus();
-}
-
-absl::Status SetBool(const Args& args, const std::string& key, bool* out) {
-  auto it = args.values.find(key);
-  if (it == args.values.end()) return absl::OkStatus();
-  if (!absl::SimpleAtob(it->second, out)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--", key, " '", it->second, "' is not true/false"));
-  }
-  return absl::OkStatus();
-}
-
-absl::Status Run(const Args& args) {
-  auto get = [&](const std::string& k) -> std::optional<std::string> {
-    auto it = args.values.find(k);
-    return it == args.values.end() ? std::nullopt : std::optional<std::string>(it->second);
-  };
+absl::Status Run(const CommandArgs& args) {
+  auto get = [&](const std::string& k) { return args.Get(k); };
   if (!get("cloud")) return absl::InvalidArgumentError("--cloud is required");
   if (!get("box")) return absl::InvalidArgumentError("--box is required");
   absl::StatusOr<BoxDims> box = ParseBoxDims(*get("box"));
@@ -155,17 +70,17 @@ absl::Status Run(const Args& args) {
     load.intrinsics = *intrinsics;
     options.camera = *intrinsics;
   }
-  for (absl::Status s : {SetDouble(args, "radius", &options.edge_points.radius_m),
-                         SetDouble(args, "threshold", &options.edge_points.threshold),
-                         SetInt(args, "samples", &options.edge_points.max_samples),
-                         SetDouble(args, "ransac_threshold", &options.segments.ransac_threshold_m),
-                         SetDouble(args, "meet_distance", &options.clubbing.meet_distance_m),
-                         SetInt(args, "threads", &options.num_threads),
-                         SetInt(args, "coarse_step", &options.edge_points.coarse_step),
-                         SetBool(args, "denoise", &options.edge_points.denoise)}) {
+  for (absl::Status s : {args.SetDouble("radius", &options.edge_points.radius_m),
+                         args.SetDouble("threshold", &options.edge_points.threshold),
+                         args.SetInt("samples", &options.edge_points.max_samples),
+                         args.SetDouble("ransac_threshold", &options.segments.ransac_threshold_m),
+                         args.SetDouble("meet_distance", &options.clubbing.meet_distance_m),
+                         args.SetInt("threads", &options.num_threads),
+                         args.SetInt("coarse_step", &options.edge_points.coarse_step),
+                         args.SetBool("denoise", &options.edge_points.denoise)}) {
     if (!s.ok()) return s;
   }
-  options.project_unorganized = !args.kdtree;
+  options.project_unorganized = !args.Has("kdtree");
   // r_s is also the gap at which a segment ends (Algorithm 1).
   options.segments.gap_m = options.edge_points.radius_m;
 
@@ -174,7 +89,7 @@ absl::Status Run(const Args& args) {
   absl::StatusOr<Detection> det = DetectBoxes(*cloud, options);
   if (!det.ok()) return det.status();
 
-  if (!args.quiet) PrintDetection(*get("cloud"), cloud->size(), *det);
+  if (!args.Has("quiet")) PrintDetection(*get("cloud"), cloud->size(), *det);
   if (auto p = get("json")) {
     if (absl::Status s = WriteDetectionJson(*p, *det, *box); !s.ok()) return s;
   }
@@ -220,7 +135,11 @@ int RunDetect(const std::vector<std::string>& argv) {
       return 0;
     }
   }
-  absl::StatusOr<Args> args = ParseArgs(argv);
+  absl::StatusOr<CommandArgs> args = ParseCommandArgs(
+      argv,
+      {"cloud", "box", "intrinsics", "json", "ply", "png", "edges", "radius", "threshold",
+       "samples", "ransac_threshold", "meet_distance", "threads", "coarse_step", "denoise"},
+      {"quiet", "kdtree"});
   if (!args.ok()) {
     std::fprintf(stderr, "cornerpose detect: %s\n\n%s",
                  std::string(args.status().message()).c_str(), kHelp);
