@@ -14,8 +14,8 @@ absl::StatusOr<PointCloud> CloudFromRequest(const v1::DetectRequest& request) {
       return CloudFromDepthImage(request.depth_image(),
                                  request.has_intrinsics() ? &request.intrinsics() : nullptr);
     case v1::DetectRequest::kSource:
-      // No sources are configured yet (ListSources is empty), so every name
-      // is unknown.
+      // The service grabs from its own sources before calling this; a name
+      // that reaches here is not one of them.
       return absl::NotFoundError(absl::StrCat("unknown source '", request.source(), "'"));
     case v1::DetectRequest::INPUT_NOT_SET:
       break;

@@ -10,8 +10,9 @@
 
 namespace cornerpose::server {
 
-// The cloud from `cloud` or `depth_image`. `source` is NOT_FOUND until frame
-// sources exist; no input at all is INVALID_ARGUMENT.
+// The cloud from `cloud` or `depth_image`. A `source` is resolved by the
+// service, which owns the sources; here it is NOT_FOUND. No input at all is
+// INVALID_ARGUMENT.
 absl::StatusOr<PointCloud> CloudFromRequest(const v1::DetectRequest& request);
 
 // The server's defaults with the request's box size and overrides applied,

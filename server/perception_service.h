@@ -3,9 +3,16 @@
 // convert the result (conversion.h); errors leave as the RPC status.
 #pragma once
 
+#include <atomic>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
 #include "common/perception/detector.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "server/detection_pool.h"
+#include "server/frame_source.h"
 
 namespace cornerpose::server {
 
@@ -13,8 +20,10 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
  public:
   // `pool` runs the detections and must outlive every RPC (the server's
   // shutdown waits for them). `defaults` are the detector options a request
-  // starts from; its box is ignored.
-  PerceptionServiceImpl(DetectionPool* pool, DetectorOptions defaults);
+  // starts from; its box is ignored. `sources` (unique names) are what
+  // requests can name; the service owns them, so they stop after the server.
+  PerceptionServiceImpl(DetectionPool* pool, DetectorOptions defaults,
+                        std::vector<std::unique_ptr<FrameSource>> sources = {});
 
   grpc::ServerUnaryReactor* Detect(grpc::CallbackServerContext* context,
                                    const v1::DetectRequest* request,
@@ -24,9 +33,20 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
                                         const v1::ListSourcesRequest* request,
                                         v1::ListSourcesResponse* response) override;
 
+  grpc::ServerWriteReactor<v1::DetectResponse>* StreamDetections(
+      grpc::CallbackServerContext* context, const v1::StreamDetectionsRequest* request) override;
+
+  // Ends every open stream (UNAVAILABLE) within a poll period. Streams run
+  // until cancelled, so the server's shutdown, which waits for RPCs in
+  // flight, calls this first.
+  void StopStreams() { stopping_streams_ = true; }
+
  private:
   DetectionPool* pool_;
   const DetectorOptions defaults_;
+  // By name; fixed after construction, so read without a lock.
+  std::map<std::string, std::unique_ptr<FrameSource>> sources_;
+  std::atomic<bool> stopping_streams_{false};
 };
 
 }  // namespace cornerpose::server

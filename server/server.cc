@@ -6,9 +6,11 @@
 #include <grpcpp/server_builder.h>
 
 #include <mutex>
+#include <set>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "server/directory_source.h"
 
 namespace cornerpose::server {
 
@@ -25,6 +27,7 @@ RunningServer::~RunningServer() { Shutdown(); }
 void RunningServer::Shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
+  service_->StopStreams();
   server_->Shutdown();
 }
 
@@ -40,6 +43,18 @@ absl::StatusOr<std::unique_ptr<RunningServer>> StartServer(const ServerOptions& 
         "max_concurrent_detections ", options.max_concurrent_detections, " must be >= 1"));
   }
 
+  std::set<std::string> names;
+  for (const SourceSpec& spec : options.sources) {
+    if (spec.name.empty()) return absl::InvalidArgumentError("a source has an empty name");
+    if (!names.insert(spec.name).second) {
+      return absl::InvalidArgumentError(absl::StrCat("source '", spec.name, "' given twice"));
+    }
+    if (!(spec.fps > 0)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("source '", spec.name, "': fps ", spec.fps, " must be > 0"));
+    }
+  }
+
   // Both are process-wide switches read when a ServerBuilder is made.
   static std::once_flag once;
   std::call_once(once, [] {
@@ -48,7 +63,16 @@ absl::StatusOr<std::unique_ptr<RunningServer>> StartServer(const ServerOptions& 
   });
 
   auto pool = std::make_unique<DetectionPool>(options.max_concurrent_detections);
-  auto service = std::make_unique<PerceptionServiceImpl>(pool.get(), DetectorOptions{});
+  // Started before the server so the first frames are loading while it
+  // binds; a source that fails is listed as FAILED rather than refusing to
+  // start (one bad recording should not take down the others).
+  std::vector<std::unique_ptr<FrameSource>> sources;
+  for (const SourceSpec& spec : options.sources) {
+    sources.push_back(std::make_unique<DirectorySource>(
+        spec.name, spec.directory, DirectorySourceOptions{.fps = spec.fps, .loop = spec.loop}));
+  }
+  auto service =
+      std::make_unique<PerceptionServiceImpl>(pool.get(), DetectorOptions{}, std::move(sources));
 
   grpc::ServerBuilder builder;
   int port = 0;

@@ -1,6 +1,7 @@
 // cornerpose_server: the perception service over gRPC.
 //
 //   cornerpose_server --listen 0.0.0.0:50051 --max_message_bytes 67108864
+//       --source bin=data/frames/carton_s:5:loop --source bricks=data/frames/brick:1:once
 //
 // Runs until SIGINT or SIGTERM, then finishes the RPCs in flight and exits.
 #include <semaphore.h>
@@ -9,12 +10,17 @@
 #include <csignal>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "absl/strings/match.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/string_view.h"
 #include "server/server.h"
 #include "server/server_options.h"
+#include "server/source_spec.h"
 
 ABSL_FLAG(std::string, listen, cornerpose::server::ServerOptions{}.listen_address,
           "host:port to listen on (port 0 picks a free one)");
@@ -23,6 +29,9 @@ ABSL_FLAG(int, max_message_bytes, cornerpose::server::ServerOptions{}.max_messag
 ABSL_FLAG(int, max_concurrent_detections,
           cornerpose::server::ServerOptions{}.max_concurrent_detections,
           "detections run at once; more wait in a queue");
+ABSL_FLAG(std::vector<std::string>, source, {},
+          "a frame source, NAME=DIR[:FPS[:loop|once]] (default 5 fps, loop); repeat the flag "
+          "or separate with commas for several");
 
 namespace {
 
@@ -38,10 +47,38 @@ void OnStopSignal(int signal) {
   sem_post(&stop_requested);
 }
 
+// Every value of --source on the command line. absl keeps only the last
+// occurrence of a flag, but several sources are naturally given as repeated
+// flags, so they are collected here before absl parses (which still
+// validates the syntax and serves --help).
+std::vector<std::string> AllSourceFlags(int argc, char** argv) {
+  std::vector<std::string> values;
+  for (int i = 1; i < argc; ++i) {
+    const absl::string_view arg = argv[i];
+    if (arg == "--") break;
+    absl::string_view value;
+    if (arg == "--source" || arg == "-source") {
+      if (i + 1 >= argc) break;
+      value = argv[++i];
+    } else if (absl::StartsWith(arg, "--source=")) {
+      value = arg.substr(9);
+    } else if (absl::StartsWith(arg, "-source=")) {
+      value = arg.substr(8);
+    } else {
+      continue;
+    }
+    for (absl::string_view part : absl::StrSplit(value, ',', absl::SkipEmpty())) {
+      values.emplace_back(part);
+    }
+  }
+  return values;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   absl::SetProgramUsageMessage("Serves cornerpose.v1.PerceptionService over gRPC.");
+  const std::vector<std::string> source_flags = AllSourceFlags(argc, argv);
   absl::ParseCommandLine(argc, argv);
 
   sem_init(&stop_requested, /*pshared=*/0, /*value=*/0);
@@ -55,6 +92,14 @@ int main(int argc, char** argv) {
   options.listen_address = absl::GetFlag(FLAGS_listen);
   options.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
   options.max_concurrent_detections = absl::GetFlag(FLAGS_max_concurrent_detections);
+  for (const std::string& text : source_flags) {
+    absl::StatusOr<cornerpose::server::SourceSpec> spec = cornerpose::server::ParseSourceSpec(text);
+    if (!spec.ok()) {
+      std::cerr << "cornerpose_server: " << spec.status() << "\n";
+      return 1;
+    }
+    options.sources.push_back(*std::move(spec));
+  }
 
   auto server = cornerpose::server::StartServer(options);
   if (!server.ok()) {

@@ -1,0 +1,61 @@
+// Where the service gets frames from when a request names a source instead of
+// sending a cloud: a camera, a recording or a directory of recorded frames.
+// Sources run on their own threads and keep only the newest frame, so a slow
+// detector drops frames instead of falling behind.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "common/perception/types.h"
+
+namespace cornerpose::server {
+
+// One captured frame.
+struct Frame {
+  PointCloud cloud;
+  // The camera the cloud came from, when known (depth images).
+  std::optional<CameraIntrinsics> camera;
+  // Increasing per source, from 1; a gap means frames were dropped.
+  uint64_t id = 0;
+  absl::Time capture_time;
+  // The name of the source.
+  std::string source;
+};
+
+enum class SourceState { kStarting, kRunning, kFailed, kFinished };
+
+// The state and, for kFailed, why (otherwise informative or empty).
+struct SourceStatus {
+  SourceState state = SourceState::kStarting;
+  std::string reason;
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+
+  virtual const std::string& name() const = 0;
+  // For ListSources: the device, recording or directory.
+  virtual std::string description() const = 0;
+
+  // The newest frame, waiting up to `timeout` for the first one.
+  // UNAVAILABLE when the source has failed (with the reason) or no frame
+  // came in time.
+  absl::StatusOr<Frame> Grab(absl::Duration timeout) { return GrabNewerThan(0, timeout); }
+
+  // The newest frame with id > last_id, waiting up to `timeout` for one (how
+  // a stream asks for the next frame without seeing one twice). UNAVAILABLE
+  // as Grab; OUT_OF_RANGE when the source finished with no newer frame.
+  virtual absl::StatusOr<Frame> GrabNewerThan(uint64_t last_id, absl::Duration timeout) = 0;
+
+  virtual SourceStatus state() const = 0;
+};
+
+// "STARTING", "RUNNING", "FAILED", "FINISHED".
+const char* SourceStateName(SourceState state);
+
+}  // namespace cornerpose::server

@@ -1,0 +1,180 @@
+// The real server on 127.0.0.1:0 with frame sources: ListSources reports
+// them, and Detect on a source runs on its newest recorded frame.
+#include <grpcpp/create_channel.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "cornerpose/v1/perception_service.grpc.pb.h"
+#include "server/server.h"
+
+namespace cornerpose::server {
+namespace {
+
+// The repository, so the test finds the bundled frames from any build dir.
+const std::string kCartonFrames = std::string(CORNERPOSE_SOURCE_DIR) + "/data/frames/carton_s";
+
+class SourceServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ServerOptions options;
+    options.listen_address = "127.0.0.1:0";
+    options.sources = {{.name = "bin", .directory = kCartonFrames, .fps = 5, .loop = true},
+                       {.name = "broken", .directory = "/nonexistent/frames"}};
+    absl::StatusOr<std::unique_ptr<RunningServer>> server = StartServer(options);
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = *std::move(server);
+    grpc::ChannelArguments args;
+    args.SetMaxReceiveMessageSize(-1);
+    stub_ = v1::PerceptionService::NewStub(grpc::CreateCustomChannel(
+        "127.0.0.1:" + std::to_string(server_->port()), grpc::InsecureChannelCredentials(), args));
+  }
+
+  v1::ListSourcesResponse ListSources() {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+    v1::ListSourcesResponse response;
+    grpc::Status s = stub_->ListSources(&context, v1::ListSourcesRequest(), &response);
+    EXPECT_TRUE(s.ok()) << s.error_message();
+    return response;
+  }
+
+  grpc::Status DetectOn(const std::string& source, v1::DetectResponse* response) {
+    v1::DetectRequest request;
+    request.set_source(source);
+    request.set_box_model("carton_s");
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+    return stub_->Detect(&context, request, response);
+  }
+
+  // Polls ListSources until `name` leaves STARTING (or 5 s pass).
+  v1::Source WaitForSource(const std::string& name) {
+    v1::Source found;
+    for (int i = 0; i < 500; ++i) {
+      const v1::ListSourcesResponse listed = ListSources();
+      for (const v1::Source& source : listed.sources()) {
+        if (source.name() == name) found = source;
+      }
+      if (found.state() != v1::SOURCE_STATE_STARTING) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return found;
+  }
+
+  std::unique_ptr<RunningServer> server_;
+  std::unique_ptr<v1::PerceptionService::Stub> stub_;
+};
+
+TEST_F(SourceServerTest, ListsSourcesWithTheirState) {
+  const v1::Source bin = WaitForSource("bin");
+  EXPECT_EQ(bin.description(), kCartonFrames);
+  EXPECT_EQ(bin.state(), v1::SOURCE_STATE_RUNNING) << bin.state_reason();
+
+  const v1::Source broken = WaitForSource("broken");
+  EXPECT_EQ(broken.description(), "/nonexistent/frames");
+  EXPECT_EQ(broken.state(), v1::SOURCE_STATE_FAILED);
+  EXPECT_NE(broken.state_reason(), "");
+  EXPECT_EQ(ListSources().sources_size(), 2);
+}
+
+TEST_F(SourceServerTest, DetectOnASourceFindsBoxesInItsNewestFrame) {
+  v1::DetectResponse first;
+  grpc::Status s = DetectOn("bin", &first);
+  ASSERT_TRUE(s.ok()) << s.error_message();
+  EXPECT_GT(first.boxes_size(), 0);
+  EXPECT_EQ(first.source(), "bin");
+  EXPECT_GT(first.frame_id(), 0u);
+  EXPECT_GT(first.capture_time_unix_nanos(), 0);
+
+  // At 5 fps a later request sees a later frame.
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  v1::DetectResponse second;
+  s = DetectOn("bin", &second);
+  ASSERT_TRUE(s.ok()) << s.error_message();
+  EXPECT_GT(second.frame_id(), first.frame_id());
+  EXPECT_GE(second.capture_time_unix_nanos(), first.capture_time_unix_nanos());
+}
+
+TEST_F(SourceServerTest, UnknownSourceIsNotFoundAndFailedSourceUnavailable) {
+  v1::DetectResponse response;
+  grpc::Status s = DetectOn("camera_7", &response);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_NE(s.error_message().find("unknown source 'camera_7'"), std::string::npos);
+
+  WaitForSource("broken");
+  s = DetectOn("broken", &response);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_NE(s.error_message().find("/nonexistent/frames"), std::string::npos) << s.error_message();
+
+  // Still serving.
+  s = DetectOn("bin", &response);
+  ASSERT_TRUE(s.ok()) << s.error_message();
+  EXPECT_EQ(response.source(), "bin");
+  EXPECT_GT(response.boxes_size(), 0);
+}
+
+TEST_F(SourceServerTest, StreamDeliversNewFramesInOrderUntilCancelled) {
+  v1::StreamDetectionsRequest request;
+  request.set_source("bin");
+  request.set_box_model("carton_s");
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+  std::unique_ptr<grpc::ClientReader<v1::DetectResponse>> reader =
+      stub_->StreamDetections(&context, request);
+
+  uint64_t last_id = 0;
+  for (int i = 0; i < 3; ++i) {
+    v1::DetectResponse response;
+    ASSERT_TRUE(reader->Read(&response)) << "frame " << i;
+    EXPECT_GT(response.frame_id(), last_id);
+    last_id = response.frame_id();
+    EXPECT_EQ(response.source(), "bin");
+    EXPECT_GT(response.boxes_size(), 0);
+  }
+  context.TryCancel();
+  v1::DetectResponse ignored;
+  while (reader->Read(&ignored)) {
+  }
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
+
+  // Still serving after the cancel.
+  v1::DetectResponse response;
+  grpc::Status s = DetectOn("bin", &response);
+  EXPECT_TRUE(s.ok()) << s.error_message();
+}
+
+TEST_F(SourceServerTest, StreamOnAnUnknownSourceIsNotFound) {
+  v1::StreamDetectionsRequest request;
+  request.set_source("camera_7");
+  request.set_box_model("carton_s");
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+  std::unique_ptr<grpc::ClientReader<v1::DetectResponse>> reader =
+      stub_->StreamDetections(&context, request);
+  v1::DetectResponse response;
+  EXPECT_FALSE(reader->Read(&response));
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+TEST_F(SourceServerTest, ShutdownEndsAStreamThatIsStillOpen) {
+  v1::StreamDetectionsRequest request;
+  request.set_source("bin");
+  request.set_box_model("carton_s");
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+  std::unique_ptr<grpc::ClientReader<v1::DetectResponse>> reader =
+      stub_->StreamDetections(&context, request);
+  v1::DetectResponse response;
+  ASSERT_TRUE(reader->Read(&response));
+  server_->Shutdown();  // must not wait for the stream forever
+  while (reader->Read(&response)) {
+  }
+  EXPECT_FALSE(reader->Finish().ok());
+}
+
+}  // namespace
+}  // namespace cornerpose::server
