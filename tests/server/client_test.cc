@@ -1,7 +1,5 @@
 // `cornerpose client detect` against the real server on 127.0.0.1:0, through
 // RunClient (the command's entry function) rather than a subprocess.
-#include "tools/client_command.h"
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -17,6 +15,7 @@
 #include "common/perception/detector.h"
 #include "server/server.h"
 #include "tests/support/scene_generator.h"
+#include "tools/client_command.h"
 
 namespace cornerpose::tools {
 namespace {
