@@ -2,6 +2,11 @@
 //
 //   cornerpose_server --listen 0.0.0.0:50051 --max_message_bytes 67108864
 //       --source bin=data/frames/carton_s:5:loop --source bricks=data/frames/brick:1:once
+//   cornerpose_server --config deploy/config/server.textproto [--listen 127.0.0.1:50051]
+//
+// With --config the file (cornerpose.v1.ServerConfig in text format) is
+// applied first, then the flags given explicitly on the command line; any
+// --source given replaces the file's sources.
 //
 // Runs until SIGINT or SIGTERM, then finishes the RPCs in flight and exits.
 #include <semaphore.h>
@@ -18,10 +23,15 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
+#include "absl/strings/strip.h"
 #include "server/server.h"
+#include "server/server_config.h"
 #include "server/server_options.h"
 #include "server/source_spec.h"
 
+ABSL_FLAG(std::string, config, "",
+          "a configuration file (cornerpose.v1.ServerConfig, protobuf text format); flags "
+          "given on the command line override it");
 ABSL_FLAG(std::string, listen, cornerpose::server::ServerOptions{}.listen_address,
           "host:port to listen on (port 0 picks a free one)");
 ABSL_FLAG(int, max_message_bytes, cornerpose::server::ServerOptions{}.max_message_bytes,
@@ -74,6 +84,23 @@ std::vector<std::string> AllSourceFlags(int argc, char** argv) {
   return values;
 }
 
+// Whether --NAME (or -NAME, with or without =VALUE) is on the command line.
+// absl does not expose this publicly, and the file's values must only be
+// overridden by flags that were actually given.
+bool SpecifiedOnCommandLine(int argc, char** argv, absl::string_view name) {
+  for (int i = 1; i < argc; ++i) {
+    absl::string_view arg = argv[i];
+    if (arg == "--") break;
+    if (!absl::ConsumePrefix(&arg, "--")) {
+      if (!absl::ConsumePrefix(&arg, "-")) continue;
+    }
+    if (arg == name || (absl::StartsWith(arg, name) && arg.substr(name.size(), 1) == "=")) {
+      return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -89,9 +116,28 @@ int main(int argc, char** argv) {
   sigaction(SIGTERM, &action, nullptr);
 
   cornerpose::server::ServerOptions options;
-  options.listen_address = absl::GetFlag(FLAGS_listen);
-  options.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
-  options.max_concurrent_detections = absl::GetFlag(FLAGS_max_concurrent_detections);
+  const std::string config = absl::GetFlag(FLAGS_config);
+  if (!config.empty()) {
+    absl::StatusOr<cornerpose::server::ServerOptions> loaded =
+        cornerpose::server::LoadServerConfig(config);
+    if (!loaded.ok()) {
+      std::cerr << "cornerpose_server: " << loaded.status() << "\n";
+      return 1;
+    }
+    options = *std::move(loaded);
+  }
+  // Without a file every flag applies (its default matches ServerOptions').
+  const auto given = [&](absl::string_view name) {
+    return config.empty() || SpecifiedOnCommandLine(argc, argv, name);
+  };
+  if (given("listen")) options.listen_address = absl::GetFlag(FLAGS_listen);
+  if (given("max_message_bytes")) {
+    options.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
+  }
+  if (given("max_concurrent_detections")) {
+    options.max_concurrent_detections = absl::GetFlag(FLAGS_max_concurrent_detections);
+  }
+  if (!source_flags.empty()) options.sources.clear();
   for (const std::string& text : source_flags) {
     absl::StatusOr<cornerpose::server::SourceSpec> spec = cornerpose::server::ParseSourceSpec(text);
     if (!spec.ok()) {

@@ -1,0 +1,164 @@
+// LoadServerConfig: every shipped configuration under deploy/ loads and
+// starts a real server (on 127.0.0.1:0) whose sources come up RUNNING, and
+// bad files fail with the right status.
+#include "server/server_config.h"
+
+#include <gmock/gmock.h>
+#include <grpcpp/create_channel.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cornerpose/v1/perception_service.grpc.pb.h"
+#include "server/server.h"
+
+namespace cornerpose::server {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+std::vector<fs::path> DeployConfigs() {
+  std::vector<fs::path> files;
+  for (const fs::directory_entry& entry :
+       fs::recursive_directory_iterator(fs::path(CORNERPOSE_SOURCE_DIR) / "deploy")) {
+    if (entry.is_regular_file() && entry.path().extension() == ".textproto") {
+      files.push_back(entry.path());
+    }
+  }
+  return files;
+}
+
+// The state of every source ListSources reports once none is STARTING (or
+// 10 s pass).
+std::vector<v1::Source> SettledSources(v1::PerceptionService::Stub& stub) {
+  v1::ListSourcesResponse response;
+  for (int i = 0; i < 1000; ++i) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+    response.Clear();
+    const grpc::Status s = stub.ListSources(&context, v1::ListSourcesRequest(), &response);
+    EXPECT_TRUE(s.ok()) << s.error_message();
+    bool starting = false;
+    for (const v1::Source& source : response.sources()) {
+      starting = starting || source.state() == v1::SOURCE_STATE_STARTING;
+    }
+    if (!starting) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return {response.sources().begin(), response.sources().end()};
+}
+
+TEST(ServerConfigTest, EveryDeployConfigStartsAServerWithItsSources) {
+  const std::vector<fs::path> files = DeployConfigs();
+  ASSERT_FALSE(files.empty()) << "no *.textproto under deploy/";
+  for (const fs::path& file : files) {
+    SCOPED_TRACE(file.string());
+    absl::StatusOr<ServerOptions> options = LoadServerConfig(file.string());
+    ASSERT_TRUE(options.ok()) << options.status();
+    ASSERT_FALSE(options->sources.empty());
+    options->listen_address = "127.0.0.1:0";
+    absl::StatusOr<std::unique_ptr<RunningServer>> server = StartServer(*options);
+    ASSERT_TRUE(server.ok()) << server.status();
+    auto stub = v1::PerceptionService::NewStub(grpc::CreateChannel(
+        "127.0.0.1:" + std::to_string((*server)->port()), grpc::InsecureChannelCredentials()));
+    const std::vector<v1::Source> listed = SettledSources(*stub);
+    ASSERT_EQ(listed.size(), options->sources.size());
+    for (const SourceSpec& spec : options->sources) {
+      bool found = false;
+      for (const v1::Source& source : listed) {
+        if (source.name() != spec.name) continue;
+        found = true;
+        EXPECT_EQ(source.state(), v1::SOURCE_STATE_RUNNING)
+            << spec.name << ": " << source.state_reason();
+      }
+      EXPECT_TRUE(found) << spec.name;
+    }
+  }
+}
+
+TEST(ServerConfigTest, ShippedConfigHasTheDocumentedValues) {
+  const fs::path file = fs::path(CORNERPOSE_SOURCE_DIR) / "deploy/config/server.textproto";
+  absl::StatusOr<ServerOptions> options = LoadServerConfig(file.string());
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(options->listen_address, "0.0.0.0:50051");
+  EXPECT_EQ(options->max_message_bytes, 64 * 1024 * 1024);
+  EXPECT_EQ(options->max_concurrent_detections, 2);
+  ASSERT_EQ(options->sources.size(), 2u);
+  EXPECT_EQ(options->sources[0].name, "carton_s");
+  EXPECT_TRUE(fs::equivalent(options->sources[0].directory,
+                             fs::path(CORNERPOSE_SOURCE_DIR) / "data/frames/carton_s"));
+  EXPECT_EQ(options->sources[0].fps, 5.0);
+  EXPECT_TRUE(options->sources[0].loop);
+  EXPECT_EQ(options->sources[1].name, "brick");
+  EXPECT_EQ(options->sources[1].fps, 2.0);
+  EXPECT_TRUE(options->sources[1].loop);
+}
+
+// Writes `text` to a fresh file in the test's temporary directory.
+std::string WriteConfig(const std::string& name, const std::string& text) {
+  const fs::path path = fs::path(::testing::TempDir()) / name;
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+TEST(ServerConfigTest, MissingFileIsNotFound) {
+  const absl::StatusOr<ServerOptions> options =
+      LoadServerConfig("/nonexistent/cornerpose/server.textproto");
+  EXPECT_EQ(options.status().code(), absl::StatusCode::kNotFound) << options.status();
+}
+
+TEST(ServerConfigTest, SyntaxErrorIsInvalidArgumentNamingTheFile) {
+  const std::string path =
+      WriteConfig("syntax_error.textproto", "listen_address: \"127.0.0.1:0\"\nsources { name: }\n");
+  const absl::StatusOr<ServerOptions> options = LoadServerConfig(path);
+  EXPECT_EQ(options.status().code(), absl::StatusCode::kInvalidArgument) << options.status();
+  EXPECT_THAT(options.status().message(), HasSubstr(path));
+  EXPECT_THAT(options.status().message(), HasSubstr("2:"));  // the parser's line
+}
+
+TEST(ServerConfigTest, DuplicateSourceNameIsInvalidArgument) {
+  const std::string path = WriteConfig("duplicate.textproto",
+                                       "sources { name: \"a\" directory: \"x\" }\n"
+                                       "sources { name: \"a\" directory: \"y\" }\n");
+  const absl::StatusOr<ServerOptions> options = LoadServerConfig(path);
+  EXPECT_EQ(options.status().code(), absl::StatusCode::kInvalidArgument) << options.status();
+  EXPECT_THAT(options.status().message(), HasSubstr("duplicate"));
+}
+
+TEST(ServerConfigTest, BadValuesAreInvalidArgument) {
+  for (const std::string text : {"sources { name: \"\" directory: \"x\" }",
+                                 "sources { name: \"a\" directory: \"x\" fps: 0 }",
+                                 "sources { name: \"a\" directory: \"x\" fps: -1 }",
+                                 "max_message_bytes: 0", "max_concurrent_detections: -2",
+                                 "box_models { key: \"tiny\" value { l: 0.1 b: 0 h: 0.1 } }"}) {
+    const absl::StatusOr<ServerOptions> options =
+        LoadServerConfig(WriteConfig("bad.textproto", text));
+    EXPECT_EQ(options.status().code(), absl::StatusCode::kInvalidArgument) << text;
+  }
+}
+
+TEST(ServerConfigTest, UnsetFieldsTakeServerOptionsDefaults) {
+  const std::string path =
+      WriteConfig("defaults.textproto", "sources { name: \"a\" directory: \"frames\" }\n");
+  const absl::StatusOr<ServerOptions> options = LoadServerConfig(path);
+  ASSERT_TRUE(options.ok()) << options.status();
+  const ServerOptions defaults;
+  EXPECT_EQ(options->listen_address, defaults.listen_address);
+  EXPECT_EQ(options->max_message_bytes, defaults.max_message_bytes);
+  EXPECT_EQ(options->max_concurrent_detections, defaults.max_concurrent_detections);
+  ASSERT_EQ(options->sources.size(), 1u);
+  EXPECT_EQ(options->sources[0].fps, SourceSpec{}.fps);
+  EXPECT_TRUE(options->sources[0].loop);
+  // Relative to the file's directory.
+  EXPECT_EQ(options->sources[0].directory, (fs::path(path).parent_path() / "frames").string());
+}
+
+}  // namespace
+}  // namespace cornerpose::server
