@@ -21,6 +21,7 @@
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "tests/support/scene_generator.h"
+#include "tools/client/response_conversion.h"
 
 namespace cornerpose::server {
 namespace {
@@ -48,22 +49,9 @@ const Frame& TheFrame() {
   return *frame;
 }
 
-v1::PointCloud PackCloud(const PointCloud& cloud) {
-  v1::PointCloud msg;
-  std::string bytes(cloud.size() * 12, '\0');
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    const float p[3] = {cloud.xyz[i].x(), cloud.xyz[i].y(), cloud.xyz[i].z()};
-    std::memcpy(bytes.data() + i * 12, p, 12);
-  }
-  msg.set_xyz(std::move(bytes));
-  msg.set_width(static_cast<uint32_t>(cloud.width));
-  msg.set_height(static_cast<uint32_t>(cloud.height));
-  return msg;
-}
-
 v1::DetectRequest FrameRequest() {
   v1::DetectRequest request;
-  *request.mutable_cloud() = PackCloud(TheFrame().scene.cloud);
+  *request.mutable_cloud() = tools::CloudToProto(TheFrame().scene.cloud);
   request.set_box_model("carton_s");
   return request;
 }

@@ -24,6 +24,7 @@
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "server/server.h"
 #include "tests/support/scene_generator.h"
+#include "tools/client/response_conversion.h"
 
 namespace cornerpose {
 namespace {
@@ -47,19 +48,6 @@ double Median(std::vector<double> v) {
   const size_t n = v.size();
   if (n == 0) return 0.0;
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-v1::PointCloud PackCloud(const PointCloud& cloud) {
-  v1::PointCloud msg;
-  std::string bytes(cloud.size() * 12, '\0');
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    const float p[3] = {cloud.xyz[i].x(), cloud.xyz[i].y(), cloud.xyz[i].z()};
-    std::memcpy(bytes.data() + i * 12, p, 12);
-  }
-  msg.set_xyz(std::move(bytes));
-  msg.set_width(static_cast<uint32_t>(cloud.width));
-  msg.set_height(static_cast<uint32_t>(cloud.height));
-  return msg;
 }
 
 bool ParseClients(const std::string& text, std::vector<int>* out) {
@@ -143,7 +131,7 @@ int Main(int argc, char** argv) {
   const std::string target = "127.0.0.1:" + std::to_string((*server)->port());
 
   v1::DetectRequest request;
-  *request.mutable_cloud() = PackCloud(scene.cloud);
+  *request.mutable_cloud() = tools::CloudToProto(scene.cloud);
   request.set_box_model("carton_s");
 
   auto make_stub = [&] {
