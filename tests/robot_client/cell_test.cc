@@ -1,0 +1,437 @@
+// The whole cell on loopback: the perception service replays the bundled
+// cell frames (data/frames/cell), the daemon subscribes over gRPC and drives
+// the UR controller emulator over its real TCP interfaces (dashboard,
+// primary, RTDE). What the emulator executed is checked against the frames'
+// ground truth, the place pattern and the workspace, and the daemon's state
+// is read through its own status service.
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
+#include "cornerpose/v1/robot_client_service.grpc.pb.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "robot_client/cell_controller.h"
+#include "robot_client/perception_subscriber.h"
+#include "robot_client/place_pattern.h"
+#include "robot_client/robot_config.h"
+#include "robot_client/status_service.h"
+#include "robot_client/ur/dashboard_client.h"
+#include "robot_client/ur/pose.h"
+#include "server/server.h"
+#include "tests/support/ur_emulator/ur_emulator.h"
+
+namespace cornerpose::robot_client {
+namespace {
+
+const std::string kSourceDir = CORNERPOSE_SOURCE_DIR;
+const std::string kCellFrames = kSourceDir + "/data/frames/cell";
+const std::string kConfig = kSourceDir + "/deploy/config/robot_client.textproto";
+
+// Simulated seconds per wall second: a pick takes ~15 s simulated.
+constexpr double kTimeScale = 20.0;
+
+struct GroundTruthBox {
+  Eigen::Isometry3d camera_T_box = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d dims = Eigen::Vector3d::Zero();
+};
+
+// The ground truth of every frame, in the order the directory source plays
+// them (file names sorted).
+std::vector<std::vector<GroundTruthBox>> LoadGroundTruth() {
+  std::vector<std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(kCellFrames)) {
+    if (entry.path().extension() == ".png") files.push_back(entry.path().stem().string());
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<std::vector<GroundTruthBox>> frames;
+  for (const std::string& stem : files) {
+    std::ifstream in(kCellFrames + "/" + stem + ".json");
+    const nlohmann::json json = nlohmann::json::parse(in);
+    std::vector<GroundTruthBox> boxes;
+    for (const nlohmann::json& b : json["boxes"]) {
+      GroundTruthBox box;
+      for (int r = 0; r < 4; ++r) {
+        for (int c = 0; c < 4; ++c)
+          box.camera_T_box.matrix()(r, c) = b["T_cam_box"][r][c].get<double>();
+      }
+      box.dims = Eigen::Vector3d(b["dims"][0].get<double>(), b["dims"][1].get<double>(),
+                                 b["dims"][2].get<double>());
+      boxes.push_back(box);
+    }
+    frames.push_back(boxes);
+  }
+  return frames;
+}
+
+// How far `tcp` (a grasp pose in the base frame) is from lying on a face of
+// `base_T_box`, in metres: the distance to the face plane, provided the point
+// is within the face (plus a margin); and the angle between the tool z axis
+// and the face's inward normal. Returns the best face.
+struct FaceFit {
+  double distance_m = 1e9;
+  double angle_deg = 180.0;
+};
+FaceFit FitToFace(const Eigen::Isometry3d& base_T_tcp, const Eigen::Isometry3d& base_T_box,
+                  const Eigen::Vector3d& dims) {
+  const Eigen::Vector3d p = base_T_box.inverse() * base_T_tcp.translation();
+  const Eigen::Vector3d half = 0.5 * dims;
+  const Eigen::Vector3d tool_z = base_T_tcp.linear().col(2);
+  FaceFit best;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (double sign : {-1.0, 1.0}) {
+      bool inside = true;
+      for (int other = 0; other < 3; ++other) {
+        if (other != axis && std::abs(p[other]) > half[other] + 0.01) inside = false;
+      }
+      if (!inside) continue;
+      const double distance = std::abs(p[axis] - sign * half[axis]);
+      const Eigen::Vector3d inward = -sign * base_T_box.linear().col(axis);
+      const double angle = std::acos(std::clamp(tool_z.dot(inward), -1.0, 1.0)) * 180.0 / M_PI;
+      if (distance < best.distance_m) best = {distance, angle};
+    }
+  }
+  return best;
+}
+
+// The digital tool output 0 (the suction) after a step.
+bool SuctionOn(const ur_emulator::ExecutedStep& step) { return (step.tool_outputs & 1u) != 0; }
+
+class CellTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    server::ServerOptions server_options;
+    server_options.listen_address = "127.0.0.1:0";
+    server_options.sources = {{.name = "cell", .directory = kCellFrames, .fps = 10, .loop = true}};
+    absl::StatusOr<std::unique_ptr<server::RunningServer>> server =
+        server::StartServer(server_options);
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = *std::move(server);
+
+    ur_emulator::UrEmulatorOptions emulator_options;
+    emulator_options.time_scale = kTimeScale;
+    emulator_options.protective_stop_unlock_delay_s = 1.0;
+    absl::StatusOr<std::unique_ptr<ur_emulator::UrEmulator>> emulator =
+        ur_emulator::UrEmulator::Start(emulator_options);
+    ASSERT_TRUE(emulator.ok()) << emulator.status();
+    emulator_ = *std::move(emulator);
+
+    absl::StatusOr<RobotClientOptions> options = LoadRobotClientConfig(kConfig);
+    ASSERT_TRUE(options.ok()) << options.status();
+    options_ = *std::move(options);
+    options_.perception.server_address = "127.0.0.1:" + std::to_string(server_->port());
+    options_.perception.source = "cell";
+    options_.robot.host = "127.0.0.1";
+    options_.robot.dashboard_port = emulator_->dashboard_port();
+    options_.robot.primary_port = emulator_->primary_port();
+    options_.robot.rtde_port = emulator_->rtde_port();
+    options_.status_listen_address = "127.0.0.1:0";
+  }
+
+  void TearDown() override {
+    if (cell_) cell_->Stop();
+    if (subscriber_) subscriber_->Stop();
+    if (cell_thread_.joinable()) cell_thread_.join();
+    status_server_.reset();
+    cell_.reset();
+    subscriber_.reset();
+  }
+
+  // Starts the daemon's parts as cornerpose_robot_client does.
+  void StartCell() {
+    PerceptionSubscriberOptions perception;
+    perception.server = options_.perception.server_address;
+    perception.source = options_.perception.source;
+    perception.box_model = options_.perception.box_model;
+    perception.box = options_.perception.box;
+    perception.initial_backoff = absl::Milliseconds(100);
+    perception.max_backoff = absl::Milliseconds(500);
+    subscriber_ = std::make_unique<PerceptionSubscriber>(perception);
+    CellControllerOptions controller;
+    controller.retry_interval = absl::Milliseconds(100);
+    controller.program_timeout = absl::Seconds(60);
+    CellCallbacks callbacks;
+    callbacks.on_program = [this](const std::string& name, const std::string& text) {
+      std::lock_guard<std::mutex> lock(programs_mutex_);
+      rendered_programs_.push_back(name + "\n" + text);
+    };
+    cell_ = std::make_unique<CellController>(options_, controller, subscriber_.get(), callbacks);
+    absl::StatusOr<std::unique_ptr<StatusServer>> status =
+        StartStatusServer(options_.status_listen_address, cell_.get());
+    ASSERT_TRUE(status.ok()) << status.status();
+    status_server_ = *std::move(status);
+    channel_ = grpc::CreateChannel("127.0.0.1:" + std::to_string(status_server_->port()),
+                                   grpc::InsecureChannelCredentials());
+    status_stub_ = v1::RobotClientService::NewStub(channel_);
+    subscriber_->Start();
+    cell_thread_ = std::thread([this] { cell_->Run(); });
+  }
+
+  // The cell's status through the status service.
+  v1::CellStatus GetStatus() {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
+    v1::CellStatus status;
+    const grpc::Status s = status_stub_->GetCellStatus(&context, {}, &status);
+    EXPECT_TRUE(s.ok()) << s.error_message();
+    return status;
+  }
+
+  // Polls the status service until `predicate` holds; false after `timeout`.
+  bool WaitForStatus(const std::function<bool(const v1::CellStatus&)>& predicate,
+                     absl::Duration timeout, v1::CellStatus* last = nullptr) {
+    const absl::Time deadline = absl::Now() + timeout;
+    v1::CellStatus status;
+    while (absl::Now() < deadline) {
+      status = GetStatus();
+      if (predicate(status)) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    if (last) *last = status;
+    return predicate(status);
+  }
+
+  std::vector<v1::PickRecord> ListPicks() {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
+    v1::ListPicksResponse response;
+    const grpc::Status s = status_stub_->ListPicks(&context, {}, &response);
+    EXPECT_TRUE(s.ok()) << s.error_message();
+    return {response.picks().begin(), response.picks().end()};
+  }
+
+  RobotClientOptions options_;
+  std::unique_ptr<server::RunningServer> server_;
+  std::unique_ptr<ur_emulator::UrEmulator> emulator_;
+  std::unique_ptr<PerceptionSubscriber> subscriber_;
+  std::unique_ptr<CellController> cell_;
+  std::unique_ptr<StatusServer> status_server_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::RobotClientService::Stub> status_stub_;
+  std::thread cell_thread_;
+  std::mutex programs_mutex_;
+  std::vector<std::string> rendered_programs_;
+};
+
+TEST_F(CellTest, PicksRealBoxesAndPlacesThemSlotBySlot) {
+  constexpr int kPicks = 4;
+  options_.max_picks = kPicks;
+  StartCell();
+  v1::CellStatus status;
+  ASSERT_TRUE(
+      WaitForStatus([](const v1::CellStatus& s) { return s.state() == v1::CELL_STATE_FINISHED; },
+                    absl::Seconds(180), &status))
+      << status.DebugString();
+  EXPECT_EQ(status.picks_done(), static_cast<uint32_t>(kPicks));
+  EXPECT_EQ(status.picks_failed(), 0u);
+  EXPECT_EQ(status.next_slot(), static_cast<uint32_t>(kPicks));
+
+  const std::vector<v1::PickRecord> picks = ListPicks();
+  const std::vector<ur_emulator::ExecutedProgram> programs = emulator_->Programs();
+  ASSERT_EQ(picks.size(), static_cast<size_t>(kPicks));
+  ASSERT_EQ(programs.size(), static_cast<size_t>(kPicks));
+  const std::vector<std::vector<GroundTruthBox>> truth = LoadGroundTruth();
+  ASSERT_EQ(truth.size(), 8u);
+
+  for (int k = 0; k < kPicks; ++k) {
+    SCOPED_TRACE("pick " + std::to_string(k + 1));
+    const v1::PickRecord& pick = picks[static_cast<size_t>(k)];
+    const ur_emulator::ExecutedProgram& program = programs[static_cast<size_t>(k)];
+    EXPECT_EQ(pick.outcome(), v1::PICK_OUTCOME_COMPLETED) << pick.detail();
+    EXPECT_EQ(program.name, pick.program_name());
+    ASSERT_EQ(program.outcome, ur_emulator::ProgramOutcome::kCompleted) << program.error_text;
+
+    // Suction on exactly from the grasp G to the place F: off before the
+    // step that switches it on, on through the moves that carry the box,
+    // off from the step that switches it off.
+    int on = -1, off = -1;
+    for (size_t i = 0; i < program.steps.size(); ++i) {
+      const bool is_set = program.steps[i].kind == "set_tool_digital_out";
+      if (is_set && on < 0 && SuctionOn(program.steps[i])) on = static_cast<int>(i);
+      if (is_set && on >= 0 && off < 0 && !SuctionOn(program.steps[i])) off = static_cast<int>(i);
+    }
+    ASSERT_GT(on, 0);
+    ASSERT_GT(off, on);
+    for (int i = 0; i < static_cast<int>(program.steps.size()); ++i) {
+      EXPECT_EQ(SuctionOn(program.steps[static_cast<size_t>(i)]), i >= on && i < off)
+          << "step " << i << " " << program.steps[static_cast<size_t>(i)].kind;
+    }
+    // Where the arm was when the suction went on is G; when it went off, F.
+    const Eigen::Isometry3d base_T_g = ur::FromUrPose(program.steps[static_cast<size_t>(on)].tcp);
+    const Eigen::Isometry3d base_T_f = ur::FromUrPose(program.steps[static_cast<size_t>(off)].tcp);
+    const ur_emulator::ExecutedStep& before_on = program.steps[static_cast<size_t>(on - 1)];
+    EXPECT_EQ(before_on.kind, "movel");  // M -> G is a straight move
+
+    // G lies on a face of a real box of the frame the daemon used, tool
+    // pointing into it.
+    const std::vector<GroundTruthBox>& frame = truth[(pick.frame_id() - 1) % truth.size()];
+    FaceFit best;
+    for (const GroundTruthBox& box : frame) {
+      const FaceFit fit = FitToFace(base_T_g, options_.base_T_camera * box.camera_T_box, box.dims);
+      if (fit.distance_m < best.distance_m) best = fit;
+    }
+    EXPECT_LT(best.distance_m, 0.010);
+    EXPECT_LT(best.angle_deg, 5.0);
+
+    // F: the box's bottom centre on slot k, so the TCP is straight above it.
+    absl::StatusOr<Eigen::Isometry3d> slot = SlotPose(options_.place_pattern, k);
+    ASSERT_TRUE(slot.ok());
+    EXPECT_LT((base_T_f.translation().head<2>() - slot->translation().head<2>()).norm(), 0.002);
+    EXPECT_EQ(pick.slot(), static_cast<uint32_t>(k));
+
+    // Nothing commanded outside the workspace.
+    for (const ur_emulator::ExecutedStep& step : program.steps) {
+      if (!step.target) continue;
+      EXPECT_TRUE(options_.workspace.Contains(step.target->position))
+          << step.kind << " to " << step.target->position.transpose();
+    }
+    // No frame captured before the previous program ended.
+    if (k > 0) {
+      const v1::PickRecord& previous = picks[static_cast<size_t>(k - 1)];
+      const double previous_end_ns =
+          static_cast<double>(previous.start_time_unix_nanos()) + previous.program_s() * 1e9;
+      EXPECT_GT(static_cast<double>(pick.capture_time_unix_nanos()), previous_end_ns);
+    }
+  }
+
+  // The daemon is healthy through standard gRPC health checking.
+  auto health = grpc::health::v1::Health::NewStub(channel_);
+  grpc::ClientContext context;
+  grpc::health::v1::HealthCheckResponse response;
+  ASSERT_TRUE(health->Check(&context, {}, &response).ok());
+  EXPECT_EQ(response.status(), grpc::health::v1::HealthCheckResponse::SERVING);
+}
+
+TEST_F(CellTest, ProtectiveStopHaltsThePickAndAReleaseResumes) {
+  options_.max_picks = 2;
+  StartCell();
+  // Mid-pick: the box is held (suction on) and the arm is moving.
+  ASSERT_TRUE(emulator_->WaitFor(
+      [](const ur_emulator::RobotSnapshot& s) {
+        return s.program_running && (s.tool_outputs & 1u) != 0;
+      },
+      absl::Seconds(60)));
+  emulator_->TriggerProtectiveStop();
+
+  v1::CellStatus status;
+  ASSERT_TRUE(WaitForStatus(
+      [](const v1::CellStatus& s) {
+        return s.state() == v1::CELL_STATE_STOPPED &&
+               s.stop_reason().find("PROTECTIVE_STOP") != std::string::npos;
+      },
+      absl::Seconds(10), &status))
+      << status.DebugString();
+  // While stopped, nothing is sent.
+  const size_t programs_at_stop = emulator_->Snapshot().programs_recorded;
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  EXPECT_EQ(emulator_->Snapshot().programs_recorded, programs_at_stop);
+  EXPECT_EQ(GetStatus().state(), v1::CELL_STATE_STOPPED);
+
+  // The operator releases the stop on the dashboard, as on a real cell
+  // (refused until the unlock delay has passed).
+  ur::DashboardClient dashboard;
+  ASSERT_TRUE(dashboard.Connect("127.0.0.1", emulator_->dashboard_port()).ok());
+  bool released = false;
+  for (int i = 0; i < 100 && !released; ++i) {
+    released = dashboard.UnlockProtectiveStop().ok();
+    if (!released) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_TRUE(released);
+
+  ASSERT_TRUE(
+      WaitForStatus([](const v1::CellStatus& s) { return s.state() == v1::CELL_STATE_FINISHED; },
+                    absl::Seconds(120), &status))
+      << status.DebugString();
+  EXPECT_EQ(status.picks_done(), 2u);
+  EXPECT_EQ(status.picks_failed(), 1u);
+  const std::vector<v1::PickRecord> picks = ListPicks();
+  std::string log;
+  for (const v1::PickRecord& pick : picks) log += pick.ShortDebugString() + "\n";
+  ASSERT_EQ(picks.size(), 3u) << log;
+  EXPECT_EQ(picks[0].outcome(), v1::PICK_OUTCOME_PROTECTIVE_STOP);
+  EXPECT_EQ(picks[1].outcome(), v1::PICK_OUTCOME_COMPLETED);
+  // The stopped pick did not take the slot: the next pick goes to slot 0.
+  EXPECT_EQ(picks[1].slot(), 0u);
+  const std::vector<ur_emulator::ExecutedProgram> programs = emulator_->Programs();
+  ASSERT_EQ(programs.size(), 3u);
+  EXPECT_EQ(programs[0].outcome, ur_emulator::ProgramOutcome::kProtectiveStop);
+}
+
+TEST_F(CellTest, LostPerceptionStreamStopsTheCellUntilTheServiceReturns) {
+  options_.max_picks = 2;
+  StartCell();
+  ASSERT_TRUE(WaitForStatus([](const v1::CellStatus& s) { return s.perception_connected(); },
+                            absl::Seconds(30)));
+  const int port = server_->port();
+  server_->Shutdown();
+  server_.reset();
+  v1::CellStatus status;
+  ASSERT_TRUE(WaitForStatus(
+      [](const v1::CellStatus& s) {
+        return s.state() == v1::CELL_STATE_STOPPED &&
+               s.stop_reason().find("perception stream lost") != std::string::npos;
+      },
+      absl::Seconds(30), &status))
+      << status.DebugString();
+
+  // The service comes back on the same address; the daemon reconnects.
+  server::ServerOptions server_options;
+  server_options.listen_address = "127.0.0.1:" + std::to_string(port);
+  server_options.sources = {{.name = "cell", .directory = kCellFrames, .fps = 10, .loop = true}};
+  absl::StatusOr<std::unique_ptr<server::RunningServer>> server =
+      server::StartServer(server_options);
+  ASSERT_TRUE(server.ok()) << server.status();
+  server_ = *std::move(server);
+  ASSERT_TRUE(
+      WaitForStatus([](const v1::CellStatus& s) { return s.state() == v1::CELL_STATE_FINISHED; },
+                    absl::Seconds(120), &status))
+      << status.DebugString();
+  EXPECT_EQ(status.picks_done(), 2u);
+}
+
+TEST_F(CellTest, DroppedControllerConnectionsAreReopened) {
+  options_.max_picks = 2;
+  StartCell();
+  ASSERT_TRUE(WaitForStatus([](const v1::CellStatus& s) { return s.picks_done() >= 1; },
+                            absl::Seconds(120)));
+  emulator_->DropConnections();
+  v1::CellStatus status;
+  ASSERT_TRUE(
+      WaitForStatus([](const v1::CellStatus& s) { return s.state() == v1::CELL_STATE_FINISHED; },
+                    absl::Seconds(120), &status))
+      << status.DebugString();
+  EXPECT_EQ(status.picks_done(), 2u);
+}
+
+TEST_F(CellTest, DryRunRendersProgramsWithoutSendingThem) {
+  options_.max_picks = 2;
+  options_.dry_run = true;
+  StartCell();
+  v1::CellStatus status;
+  ASSERT_TRUE(
+      WaitForStatus([](const v1::CellStatus& s) { return s.state() == v1::CELL_STATE_FINISHED; },
+                    absl::Seconds(60), &status))
+      << status.DebugString();
+  EXPECT_TRUE(status.dry_run());
+  EXPECT_EQ(emulator_->Snapshot().programs_recorded, 0u);
+  const std::vector<v1::PickRecord> picks = ListPicks();
+  ASSERT_EQ(picks.size(), 2u);
+  EXPECT_EQ(picks[0].outcome(), v1::PICK_OUTCOME_DRY_RUN);
+  std::lock_guard<std::mutex> lock(programs_mutex_);
+  ASSERT_EQ(rendered_programs_.size(), 2u);
+  EXPECT_NE(rendered_programs_[0].find("def pick_0001():"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cornerpose::robot_client

@@ -1,0 +1,157 @@
+// SelectPick: rejections with reasons (score, tilt, workspace,
+// reachability), topmost first with a height tolerance, then score.
+#include "robot_client/pick_selection.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace cornerpose::robot_client {
+namespace {
+
+using ::testing::HasSubstr;
+
+const BoxDims kCarton{0.30, 0.20, 0.15};
+
+// A flat carton whose top face (+z, the grasp face) is at height top_z.
+DetectedBox Box(double x, double y, double top_z, double score) {
+  DetectedBox box;
+  box.camera_T_box.translation() = Eigen::Vector3d(x, y, top_z - 0.075);
+  box.grasp_face = BoxFace::kPlusZ;
+  box.score = score;
+  return box;
+}
+
+class PickSelectionTest : public ::testing::Test {
+ protected:
+  PickSelection Select(const std::vector<DetectedBox>& boxes,
+                       const Reachability& reachable = nullptr) {
+    // The boxes are given in the base frame: base_T_camera = identity.
+    return SelectPick(boxes, Eigen::Isometry3d::Identity(), kCarton, selection_, workspace_,
+                      waypoints_, reachable);
+  }
+
+  SelectionOptions selection_;  // 30 deg, score >= 0, ties within 1 cm
+  WaypointOptions waypoints_;   // d 0.10, h 0.25
+  Workspace workspace_{Eigen::Vector3d(-0.6, -0.9, 0.03), Eigen::Vector3d(0.6, 0.8, 0.9)};
+};
+
+TEST_F(PickSelectionTest, NoBoxesNoChoice) {
+  const PickSelection s = Select({});
+  EXPECT_FALSE(s.chosen.has_value());
+  EXPECT_TRUE(s.verdicts.empty());
+}
+
+TEST_F(PickSelectionTest, TiltedFaceIsRejected) {
+  DetectedBox tilted = Box(0, -0.5, 0.15, 0.9);
+  tilted.camera_T_box.linear() =
+      Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  DetectedBox slight = Box(0.2, -0.5, 0.15, 0.5);
+  slight.camera_T_box.linear() =
+      Eigen::AngleAxisd(20.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const PickSelection s = Select({tilted, slight});
+  ASSERT_EQ(s.verdicts.size(), 2u);
+  EXPECT_FALSE(s.verdicts[0].accepted);
+  EXPECT_THAT(s.verdicts[0].reason, HasSubstr("tilted 40.0 deg"));
+  EXPECT_NEAR(s.verdicts[0].box.tilt_deg, 40.0, 1e-6);
+  EXPECT_TRUE(s.verdicts[1].accepted) << s.verdicts[1].reason;
+  EXPECT_EQ(s.chosen, 1);
+}
+
+TEST_F(PickSelectionTest, OutsideTheWorkspaceIsRejected) {
+  // One too far out in x; one whose R (0.75 + 0.25) is above the workspace.
+  const PickSelection s = Select({Box(0.9, -0.5, 0.15, 0.9), Box(0, -0.5, 0.75, 0.9)});
+  ASSERT_EQ(s.verdicts.size(), 2u);
+  EXPECT_FALSE(s.chosen.has_value());
+  EXPECT_THAT(s.verdicts[0].reason, HasSubstr("grasp point G"));
+  EXPECT_THAT(s.verdicts[0].reason, HasSubstr("outside the workspace"));
+  EXPECT_THAT(s.verdicts[1].reason, HasSubstr("retrieve point R"));
+}
+
+TEST_F(PickSelectionTest, UnreachableIsRejected) {
+  // Nothing beyond 0.4 m from the base axis is reachable.
+  const Reachability near_base = [](const Eigen::Isometry3d& T) {
+    return T.translation().head<2>().norm() < 0.4;
+  };
+  const PickSelection s =
+      Select({Box(0.0, -0.5, 0.15, 0.99), Box(0.0, -0.3, 0.15, 0.2)}, near_base);
+  EXPECT_FALSE(s.verdicts[0].accepted);
+  EXPECT_THAT(s.verdicts[0].reason, HasSubstr("not reachable"));
+  EXPECT_TRUE(s.verdicts[1].accepted);
+  EXPECT_EQ(s.chosen, 1);
+
+  const Reachability nothing = [](const Eigen::Isometry3d&) { return false; };
+  EXPECT_FALSE(Select({Box(0.0, -0.3, 0.15, 0.2)}, nothing).chosen.has_value());
+}
+
+TEST_F(PickSelectionTest, LowScoreIsRejected) {
+  selection_.min_score = 0.5;
+  const PickSelection s = Select({Box(0, -0.5, 0.30, 0.4), Box(0.2, -0.5, 0.15, 0.6)});
+  EXPECT_THAT(s.verdicts[0].reason, HasSubstr("below min_score"));
+  EXPECT_EQ(s.chosen, 1);  // lower, but the only one accepted
+}
+
+TEST_F(PickSelectionTest, TopmostFirstThenScore) {
+  // B is clearly the highest.
+  EXPECT_EQ(Select({Box(0, -0.5, 0.15, 0.9), Box(0.2, -0.5, 0.30, 0.5)}).chosen, 1);
+  // C is 5 mm above B: a tie, decided by C's higher score; D, 7 mm below C,
+  // ties with C too and scores higher still.
+  const std::vector<DetectedBox> boxes = {Box(0, -0.5, 0.15, 0.99), Box(0.2, -0.5, 0.300, 0.5),
+                                          Box(-0.2, -0.5, 0.305, 0.8)};
+  EXPECT_EQ(Select(boxes).chosen, 2);
+  std::vector<DetectedBox> with_d = boxes;
+  with_d.push_back(Box(0.2, -0.7, 0.298, 0.95));
+  EXPECT_EQ(Select(with_d).chosen, 3);
+  // A box 2 cm lower does not tie, however good its score.
+  std::vector<DetectedBox> with_e = boxes;
+  with_e.push_back(Box(0.2, -0.7, 0.285, 1.0));
+  EXPECT_EQ(Select(with_e).chosen, 2);
+  // Equal heights and scores: the first.
+  EXPECT_EQ(Select({Box(0, -0.5, 0.15, 0.7), Box(0.2, -0.5, 0.15, 0.7)}).chosen, 0);
+}
+
+TEST_F(PickSelectionTest, RankedListsTheAcceptedBoxesBestFirst) {
+  // A 0.15 (0.9), B 0.300 (0.5), C 0.305 (0.8), D rejected (tilted), E 0.15
+  // (0.95), F 0.297 (0.5, ties with B on everything but height).
+  DetectedBox d = Box(0.1, -0.6, 0.40, 0.99);
+  d.camera_T_box.linear() =
+      Eigen::AngleAxisd(50.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const PickSelection s =
+      Select({Box(0, -0.5, 0.15, 0.9), Box(0.2, -0.5, 0.300, 0.5), Box(-0.2, -0.5, 0.305, 0.8), d,
+              Box(0.2, -0.7, 0.15, 0.95), Box(-0.2, -0.7, 0.297, 0.5)});
+  ASSERT_TRUE(s.chosen.has_value());
+  EXPECT_FALSE(s.verdicts[3].accepted);
+  // C wins the top tie; then B and F tie (B higher); then the table level,
+  // where E's score beats A's.
+  EXPECT_EQ(s.ranked, (std::vector<int>{2, 1, 5, 4, 0}));
+  EXPECT_EQ(s.chosen, s.ranked.front());
+  // Nothing accepted: nothing ranked.
+  selection_.min_score = 0.999;
+  const PickSelection none = Select({Box(0, -0.5, 0.15, 0.9)});
+  EXPECT_TRUE(none.ranked.empty());
+  EXPECT_FALSE(none.chosen.has_value());
+}
+
+TEST_F(PickSelectionTest, BoxesGoThroughTheHandEyeCalibration) {
+  // The camera 1.1 m up looking down; a box 0.95 m in front of it is on the
+  // table (top at 0.15).
+  Eigen::Isometry3d base_T_camera = Eigen::Isometry3d::Identity();
+  base_T_camera.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  base_T_camera.translation() = Eigen::Vector3d(0, -0.5, 1.1);
+  DetectedBox seen;
+  seen.camera_T_box.translation() = Eigen::Vector3d(0.05, 0.0, 1.025);
+  seen.camera_T_box.linear() =
+      Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();  // box z up
+  seen.grasp_face = BoxFace::kPlusZ;
+  seen.score = 0.8;
+  const PickSelection s =
+      SelectPick({seen}, base_T_camera, kCarton, selection_, workspace_, waypoints_, nullptr);
+  ASSERT_EQ(s.chosen, 0) << s.verdicts[0].reason;
+  EXPECT_TRUE(s.verdicts[0].box.grasp_point.isApprox(Eigen::Vector3d(0.05, -0.5, 0.15), 1e-9));
+  EXPECT_NEAR(s.verdicts[0].box.tilt_deg, 0.0, 1e-6);
+}
+
+}  // namespace
+}  // namespace cornerpose::robot_client
