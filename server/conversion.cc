@@ -32,6 +32,19 @@ absl::Status CheckGrid(uint64_t width, uint64_t height, uint64_t count, absl::st
 
 }  // namespace
 
+v1::PointCloud CloudToProto(const PointCloud& cloud) {
+  v1::PointCloud msg;
+  std::string bytes(cloud.size() * kBytesPerPoint, '\0');
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const float p[3] = {cloud.xyz[i].x(), cloud.xyz[i].y(), cloud.xyz[i].z()};
+    std::memcpy(bytes.data() + i * kBytesPerPoint, p, kBytesPerPoint);
+  }
+  msg.set_xyz(std::move(bytes));
+  msg.set_width(static_cast<uint32_t>(cloud.width));
+  msg.set_height(static_cast<uint32_t>(cloud.height));
+  return msg;
+}
+
 absl::StatusOr<PointCloud> CloudFromProto(const v1::PointCloud& cloud) {
   const std::string& bytes = cloud.xyz();
   if (bytes.size() % kBytesPerPoint != 0) {
@@ -223,6 +236,14 @@ v1::DetectResponse DetectionToProto(const Detection& detection, bool include_edg
   t->set_poses_ms(detection.timings.poses_ms);
   t->set_total_ms(detection.timings.total_ms);
   return out;
+}
+
+void AddFrameToProto(const Frame& frame, const FrameContents& contents,
+                     v1::DetectResponse* response) {
+  response->set_frame_id(frame.id);
+  response->set_capture_time_unix_nanos(absl::ToUnixNanos(frame.capture_time));
+  response->set_source(frame.source);
+  if (contents.include_cloud) *response->mutable_cloud() = CloudToProto(frame.cloud);
 }
 
 }  // namespace cornerpose::server

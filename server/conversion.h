@@ -9,6 +9,7 @@
 #include "common/perception/types.h"
 #include "cornerpose/v1/geometry.pb.h"
 #include "cornerpose/v1/perception_service.pb.h"
+#include "server/frame_source.h"
 
 namespace cornerpose::server {
 
@@ -20,6 +21,11 @@ inline constexpr uint64_t kMaxPoints = 20'000'000;
 // cloud has more than kMaxPoints points. An all-empty message is an empty
 // cloud.
 absl::StatusOr<PointCloud> CloudFromProto(const v1::PointCloud& cloud);
+
+// Packs xyz as little-endian float32 triples, keeping width x height (and
+// the NaNs of an organized cloud): the inverse of CloudFromProto. Clients
+// send clouds with it; the server returns a source's frame with it.
+v1::PointCloud CloudToProto(const PointCloud& cloud);
 
 // INVALID_ARGUMENT unless the size is positive and the focal lengths are
 // positive and finite.
@@ -45,5 +51,15 @@ v1::BoxFace ToProto(BoxFace face);
 
 // Boxes, segments, corners and timings; the edge points only when asked.
 v1::DetectResponse DetectionToProto(const Detection& detection, bool include_edge_points);
+
+// What a response about a source's frame carries besides the detection.
+struct FrameContents {
+  bool include_cloud = false;  // the frame's cloud (large)
+};
+
+// Sets the frame's id, capture time and source on `response`, and its cloud
+// when asked.
+void AddFrameToProto(const Frame& frame, const FrameContents& contents,
+                     v1::DetectResponse* response);
 
 }  // namespace cornerpose::server

@@ -24,13 +24,18 @@ absl::StatusOr<PointCloud> CloudFromRequest(const v1::DetectRequest& request) {
 }
 
 absl::StatusOr<DetectorOptions> DetectorOptionsFromRequest(const v1::DetectRequest& request,
-                                                           const DetectorOptions& defaults) {
+                                                           const DetectorOptions& defaults,
+                                                           const BoxModels& models) {
   DetectorOptions options = defaults;
   switch (request.box_size_case()) {
     case v1::DetectRequest::kBox:
       options.box = BoxDimsFromProto(request.box());
       break;
     case v1::DetectRequest::kBoxModel: {
+      if (auto it = models.find(request.box_model()); it != models.end()) {
+        options.box = it->second;
+        break;
+      }
       absl::StatusOr<BoxDims> model = BoxModelByName(request.box_model());
       // An unknown name is the caller's mistake, not a missing resource.
       if (!model.ok()) return absl::InvalidArgumentError(model.status().message());
@@ -50,18 +55,21 @@ absl::StatusOr<DetectorOptions> DetectorOptionsFromRequest(const v1::DetectReque
     options.camera = *camera;
   }
 
-  const v1::DetectorOverrides& overrides = request.overrides();
-  if (overrides.has_edge_radius_m()) {
-    options.edge_points.radius_m = overrides.edge_radius_m();
-    // Algorithm 1 ends a segment at a gap wider than r_s (as the CLI does).
-    options.segments.gap_m = overrides.edge_radius_m();
-  }
-  if (overrides.has_edge_threshold()) options.edge_points.threshold = overrides.edge_threshold();
-  if (overrides.has_ransac_threshold_m()) {
-    options.segments.ransac_threshold_m = overrides.ransac_threshold_m();
-  }
+  ApplyDetectorOverrides(request.overrides(), &options);
   if (absl::Status s = options.Validate(); !s.ok()) return s;
   return options;
+}
+
+void ApplyDetectorOverrides(const v1::DetectorOverrides& overrides, DetectorOptions* options) {
+  if (overrides.has_edge_radius_m()) {
+    options->edge_points.radius_m = overrides.edge_radius_m();
+    // Algorithm 1 ends a segment at a gap wider than r_s (as the CLI does).
+    options->segments.gap_m = overrides.edge_radius_m();
+  }
+  if (overrides.has_edge_threshold()) options->edge_points.threshold = overrides.edge_threshold();
+  if (overrides.has_ransac_threshold_m()) {
+    options->segments.ransac_threshold_m = overrides.ransac_threshold_m();
+  }
 }
 
 }  // namespace cornerpose::server

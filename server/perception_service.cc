@@ -61,25 +61,28 @@ absl::StatusOr<Frame> GrabFromSource(
 }
 
 grpc::Status RunDetect(grpc::CallbackServerContext& context, const v1::DetectRequest& request,
-                       const DetectorOptions& defaults,
+                       const DetectorOptions& defaults, const BoxModels& box_models,
                        const std::map<std::string, std::unique_ptr<FrameSource>>& sources,
                        v1::DetectResponse& response) {
   if (grpc::Status s = CheckStillWanted(context); !s.ok()) return s;
-  absl::StatusOr<DetectorOptions> options = DetectorOptionsFromRequest(request, defaults);
+  absl::StatusOr<DetectorOptions> options =
+      DetectorOptionsFromRequest(request, defaults, box_models);
   if (!options.ok()) return ToGrpcStatus(options.status());
   std::optional<Frame> frame;
-  absl::StatusOr<PointCloud> cloud;
+  absl::StatusOr<PointCloud> sent;
+  const PointCloud* cloud = nullptr;
   if (request.input_case() == v1::DetectRequest::kSource) {
     absl::StatusOr<Frame> grabbed = GrabFromSource(sources, request.source(), context);
     if (!grabbed.ok()) return ToGrpcStatus(grabbed.status());
     frame = *std::move(grabbed);
-    cloud = std::move(frame->cloud);
+    cloud = &frame->cloud;
     // The source knows its camera; the request's intrinsics do not apply.
     if (frame->camera) options->camera = frame->camera;
   } else {
-    cloud = CloudFromRequest(request);
+    sent = CloudFromRequest(request);
+    if (!sent.ok()) return ToGrpcStatus(sent.status());
+    cloud = &*sent;
   }
-  if (!cloud.ok()) return ToGrpcStatus(cloud.status());
   if (grpc::Status s = CheckStillWanted(context); !s.ok()) return s;
 
   absl::StatusOr<Detection> detection = DetectBoxes(*cloud, *options);
@@ -87,19 +90,16 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, const v1::DetectReq
 
   if (grpc::Status s = CheckStillWanted(context); !s.ok()) return s;
   response = DetectionToProto(*detection, request.include_edge_points());
-  if (frame) {
-    response.set_frame_id(frame->id);
-    response.set_capture_time_unix_nanos(absl::ToUnixNanos(frame->capture_time));
-    response.set_source(frame->source);
-  }
+  if (frame) AddFrameToProto(*frame, {.include_cloud = request.include_cloud()}, &response);
   return grpc::Status::OK;
 }
 
 }  // namespace
 
 PerceptionServiceImpl::PerceptionServiceImpl(DetectionPool* pool, DetectorOptions defaults,
-                                             std::vector<std::unique_ptr<FrameSource>> sources)
-    : pool_(pool), defaults_(std::move(defaults)) {
+                                             std::vector<std::unique_ptr<FrameSource>> sources,
+                                             BoxModels box_models)
+    : pool_(pool), defaults_(std::move(defaults)), box_models_(std::move(box_models)) {
   for (std::unique_ptr<FrameSource>& source : sources) {
     const std::string name = source->name();
     sources_.emplace(name, std::move(source));
@@ -112,7 +112,7 @@ grpc::ServerUnaryReactor* PerceptionServiceImpl::Detect(grpc::CallbackServerCont
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   // context, request and response stay valid until Finish.
   pool_->Submit([this, context, request, response, reactor] {
-    reactor->Finish(RunDetect(*context, *request, defaults_, sources_, *response));
+    reactor->Finish(RunDetect(*context, *request, defaults_, box_models_, sources_, *response));
   });
   return reactor;
 }
@@ -146,15 +146,17 @@ grpc::ServerWriteReactor<v1::DetectResponse>* PerceptionServiceImpl::StreamDetec
   if (request->has_box()) *as_detect.mutable_box() = request->box();
   if (request->has_box_model()) as_detect.set_box_model(request->box_model());
   *as_detect.mutable_overrides() = request->overrides();
-  absl::StatusOr<DetectorOptions> options = DetectorOptionsFromRequest(as_detect, defaults_);
+  absl::StatusOr<DetectorOptions> options =
+      DetectorOptionsFromRequest(as_detect, defaults_, box_models_);
   if (!options.ok()) return new StreamDetectionsReactor(ToGrpcStatus(options.status()));
   auto it = sources_.find(request->source());
   if (it == sources_.end()) {
     return new StreamDetectionsReactor(ToGrpcStatus(
         absl::NotFoundError(absl::StrCat("unknown source '", request->source(), "'"))));
   }
-  return new StreamDetectionsReactor(pool_, it->second.get(), *std::move(options),
-                                     request->include_edge_points(), &stopping_streams_);
+  return new StreamDetectionsReactor(
+      pool_, it->second.get(), *std::move(options), request->include_edge_points(),
+      {.include_cloud = request->include_cloud()}, &stopping_streams_);
 }
 
 }  // namespace cornerpose::server

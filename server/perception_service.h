@@ -11,6 +11,7 @@
 
 #include "common/perception/detector.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
+#include "server/detect_request.h"
 #include "server/detection_pool.h"
 #include "server/frame_source.h"
 
@@ -20,10 +21,12 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
  public:
   // `pool` runs the detections and must outlive every RPC (the server's
   // shutdown waits for them). `defaults` are the detector options a request
-  // starts from; its box is ignored. `sources` (unique names) are what
+  // starts from; its box is ignored. `box_models` are the server's own named
+  // box sizes (before the built-in ones). `sources` (unique names) are what
   // requests can name; the service owns them, so they stop after the server.
   PerceptionServiceImpl(DetectionPool* pool, DetectorOptions defaults,
-                        std::vector<std::unique_ptr<FrameSource>> sources = {});
+                        std::vector<std::unique_ptr<FrameSource>> sources = {},
+                        BoxModels box_models = {});
 
   grpc::ServerUnaryReactor* Detect(grpc::CallbackServerContext* context,
                                    const v1::DetectRequest* request,
@@ -44,6 +47,7 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
  private:
   DetectionPool* pool_;
   const DetectorOptions defaults_;
+  const BoxModels box_models_;
   // By name; fixed after construction, so read without a lock.
   std::map<std::string, std::unique_ptr<FrameSource>> sources_;
   std::atomic<bool> stopping_streams_{false};

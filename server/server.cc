@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "server/directory_source.h"
+#include "server/source_factory.h"
 
 namespace cornerpose::server {
 
@@ -66,13 +66,9 @@ absl::StatusOr<std::unique_ptr<RunningServer>> StartServer(const ServerOptions& 
   // Started before the server so the first frames are loading while it
   // binds; a source that fails is listed as FAILED rather than refusing to
   // start (one bad recording should not take down the others).
-  std::vector<std::unique_ptr<FrameSource>> sources;
-  for (const SourceSpec& spec : options.sources) {
-    sources.push_back(std::make_unique<DirectorySource>(
-        spec.name, spec.directory, DirectorySourceOptions{.fps = spec.fps, .loop = spec.loop}));
-  }
-  auto service =
-      std::make_unique<PerceptionServiceImpl>(pool.get(), DetectorOptions{}, std::move(sources));
+  std::vector<std::unique_ptr<FrameSource>> sources = MakeFrameSources(options.sources);
+  auto service = std::make_unique<PerceptionServiceImpl>(pool.get(), options.detector,
+                                                         std::move(sources), options.box_models);
 
   grpc::ServerBuilder builder;
   int port = 0;

@@ -15,6 +15,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "cornerpose/v1/server_config.pb.h"
+#include "server/detect_request.h"
 
 namespace cornerpose::server {
 namespace {
@@ -89,29 +90,64 @@ absl::StatusOr<ServerOptions> LoadServerConfig(const std::string& path) {
     if (!names.insert(source.name()).second) {
       return Invalid(path, absl::StrCat(where, ": duplicate source name \"", source.name(), "\""));
     }
-    if (source.directory().empty()) {
-      return Invalid(path, absl::StrCat(where, " (", source.name(), "): empty directory"));
+    const std::string label = absl::StrCat(where, " (", source.name(), ")");
+    SourceSpec spec;
+    spec.name = source.name();
+    switch (source.kind_case()) {
+      case v1::SourceConfig::kDirectory: {
+        if (source.directory().empty()) return Invalid(path, label + ": empty directory");
+        std::filesystem::path directory(source.directory());
+        if (directory.is_relative()) directory = (base / directory).lexically_normal();
+        spec.directory = directory.string();
+        break;
+      }
+      case v1::SourceConfig::kDeviceUri:
+        spec.kind = SourceKind::kOpenNi2Device;
+        spec.uri = source.device_uri();
+        break;
+      case v1::SourceConfig::kOniFile: {
+        if (source.oni_file().empty()) return Invalid(path, label + ": empty oni_file");
+        spec.kind = SourceKind::kOniFile;
+        std::filesystem::path file(source.oni_file());
+        if (file.is_relative()) file = (base / file).lexically_normal();
+        spec.uri = file.string();
+        break;
+      }
+      case v1::SourceConfig::KIND_NOT_SET:
+        return Invalid(path, label + ": set one of directory, device_uri or oni_file");
     }
     if (source.has_fps() && !(source.fps() > 0 && std::isfinite(source.fps()))) {
       return Invalid(
           path, absl::StrCat(where, " (", source.name(), "): fps must be > 0, got ", source.fps()));
     }
-    SourceSpec spec;
-    spec.name = source.name();
-    std::filesystem::path directory(source.directory());
-    if (directory.is_relative()) directory = (base / directory).lexically_normal();
-    spec.directory = directory.string();
     if (source.has_fps()) spec.fps = source.fps();
     if (source.has_loop()) spec.loop = source.loop();
+    if (source.has_playback_speed()) {
+      if (!(source.playback_speed() > 0 && std::isfinite(source.playback_speed()))) {
+        return Invalid(path, absl::StrCat(label, ": playback_speed must be > 0, got ",
+                                          source.playback_speed()));
+      }
+      spec.playback_speed = source.playback_speed();
+    }
     options.sources.push_back(std::move(spec));
   }
 
   for (const auto& [name, box] : config.box_models()) {
     if (name.empty()) return Invalid(path, "box_models: empty model name");
-    if (!(box.l() > 0) || !(box.b() > 0) || !(box.h() > 0)) {
+    if (!(box.l() > 0) || !(box.b() > 0) || !(box.h() > 0) || !std::isfinite(box.l()) ||
+        !std::isfinite(box.b()) || !std::isfinite(box.h())) {
       return Invalid(path,
                      absl::StrCat("box_models[\"", name, "\"]: l, b and h must be > 0 metres"));
     }
+    options.box_models[name] = BoxDims{box.l(), box.b(), box.h()};
+  }
+
+  ApplyDetectorOverrides(config.detector_defaults(), &options.detector);
+  // Validated with a stand-in box: requests bring their own.
+  DetectorOptions check = options.detector;
+  check.box = {0.3, 0.2, 0.15};
+  if (absl::Status s = check.Validate(); !s.ok()) {
+    return Invalid(path, absl::StrCat("detector_defaults: ", s.message()));
   }
   return options;
 }

@@ -11,13 +11,13 @@
 namespace cornerpose::server {
 
 // Reads and validates the file at `path`. Fields left unset take
-// ServerOptions' defaults; a relative source directory is resolved against
-// the file's directory. NOT_FOUND when the file does not exist;
-// INVALID_ARGUMENT (naming the file) for a syntax error (with the parser's
-// line:column) or a bad value: an empty or duplicate source name, an empty
-// directory, fps <= 0, a limit <= 0 (or too large), an empty box model name
-// or a non-positive box size. box_models are validated but not yet used:
-// Detect knows only the built-in models.
+// ServerOptions' defaults; a relative source directory or oni_file is
+// resolved against the file's directory (device_uri is taken as is).
+// NOT_FOUND when the file does not exist; INVALID_ARGUMENT (naming the file)
+// for a syntax error (with the parser's line:column) or a bad value: an empty
+// or duplicate source name, a source with no kind, an empty directory or
+// oni_file, fps or playback_speed <= 0, a limit <= 0 (or too large), an empty box model name
+// or a non-positive box size, or detector_defaults the detector refuses.
 absl::StatusOr<ServerOptions> LoadServerConfig(const std::string& path);
 
 }  // namespace cornerpose::server

@@ -2,6 +2,7 @@
 //
 //   cornerpose_server --listen 0.0.0.0:50051 --max_message_bytes 67108864
 //       --source bin=data/frames/carton_s:5:loop --source bricks=data/frames/brick:1:once
+//       --source cam=openni2: --source rec=oni:recording.oni:1:loop
 //   cornerpose_server --config deploy/config/server.textproto [--listen 127.0.0.1:50051]
 //
 // With --config the file (cornerpose.v1.ServerConfig in text format) is
@@ -40,8 +41,10 @@ ABSL_FLAG(int, max_concurrent_detections,
           cornerpose::server::ServerOptions{}.max_concurrent_detections,
           "detections run at once; more wait in a queue");
 ABSL_FLAG(std::vector<std::string>, source, {},
-          "a frame source, NAME=DIR[:FPS[:loop|once]] (default 5 fps, loop); repeat the flag "
-          "or separate with commas for several");
+          "a frame source: NAME=DIR[:FPS[:loop|once]] (recorded frames, default 5 fps, loop), "
+          "NAME=openni2:[URI] (an OpenNI2 camera; empty URI = any), or "
+          "NAME=oni:FILE[:SPEED][:loop|once] (an OpenNI2 recording); repeat the flag or "
+          "separate with commas for several");
 
 namespace {
 

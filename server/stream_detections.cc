@@ -19,11 +19,13 @@ StreamDetectionsReactor::StreamDetectionsReactor(const grpc::Status& error) { Fi
 
 StreamDetectionsReactor::StreamDetectionsReactor(DetectionPool* pool, FrameSource* source,
                                                  DetectorOptions options, bool include_edge_points,
+                                                 FrameContents contents,
                                                  const std::atomic<bool>* stopping)
     : pool_(pool),
       source_(source),
       options_(std::move(options)),
       include_edge_points_(include_edge_points),
+      contents_(contents),
       stopping_(stopping) {
   thread_ = std::thread([this] { Run(); });
 }
@@ -93,9 +95,7 @@ void StreamDetectionsReactor::Run() {
       break;
     }
     response_ = DetectionToProto(*result, include_edge_points_);
-    response_.set_frame_id(frame->id);
-    response_.set_capture_time_unix_nanos(absl::ToUnixNanos(frame->capture_time));
-    response_.set_source(frame->source);
+    AddFrameToProto(*frame, contents_, &response_);
 
     std::unique_lock<std::mutex> lock(mutex_);
     write_pending_ = true;

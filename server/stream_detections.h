@@ -9,6 +9,7 @@
 
 #include "common/perception/detector.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
+#include "server/conversion.h"
 #include "server/detection_pool.h"
 #include "server/frame_source.h"
 
@@ -26,7 +27,8 @@ class StreamDetectionsReactor final : public grpc::ServerWriteReactor<v1::Detect
   // Streams until cancelled, the source ends or fails, or *stopping is set
   // (server shutdown). Everything pointed to outlives the RPC.
   StreamDetectionsReactor(DetectionPool* pool, FrameSource* source, DetectorOptions options,
-                          bool include_edge_points, const std::atomic<bool>* stopping);
+                          bool include_edge_points, FrameContents contents,
+                          const std::atomic<bool>* stopping);
 
   void OnWriteDone(bool ok) override;
   void OnCancel() override;
@@ -41,6 +43,7 @@ class StreamDetectionsReactor final : public grpc::ServerWriteReactor<v1::Detect
   FrameSource* source_ = nullptr;
   const DetectorOptions options_;
   const bool include_edge_points_ = false;
+  const FrameContents contents_;
   const std::atomic<bool>* stopping_ = nullptr;
 
   std::mutex mutex_;

@@ -1,5 +1,6 @@
-// `cornerpose client detect` against the real server on 127.0.0.1:0, through
-// RunClient (the command's entry function) rather than a subprocess.
+// `cornerpose client detect|stream|sources|health` against the real server on
+// 127.0.0.1:0, through RunClient (the command's entry function) rather than a
+// subprocess.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -22,9 +23,14 @@ namespace {
 
 using ::testing::HasSubstr;
 
-std::unique_ptr<server::RunningServer> StartLoopbackServer() {
+// The bundled recorded frames, found through the source tree.
+const std::string kCartonFrames = std::string(CORNERPOSE_SOURCE_DIR) + "/data/frames/carton_s";
+
+std::unique_ptr<server::RunningServer> StartLoopbackServer(
+    std::vector<server::SourceSpec> sources = {}) {
   server::ServerOptions options;
   options.listen_address = "127.0.0.1:0";
+  options.sources = std::move(sources);
   absl::StatusOr<std::unique_ptr<server::RunningServer>> running = server::StartServer(options);
   EXPECT_TRUE(running.ok()) << running.status();
   return running.ok() ? *std::move(running) : nullptr;
@@ -91,7 +97,7 @@ TEST(ClientTest, UnreachableServerFailsQuicklyWithExitCodeOne) {
   const std::string err = ::testing::internal::GetCapturedStderr();
   EXPECT_EQ(rc, 1);
   EXPECT_LT(seconds, 5.0);
-  EXPECT_THAT(err, HasSubstr("cornerpose client: "));
+  EXPECT_THAT(err, HasSubstr("cornerpose client detect: "));
   EXPECT_THAT(err, HasSubstr("cannot reach server"));
 }
 
@@ -100,6 +106,118 @@ TEST(ClientTest, BadUsageIsExitCodeTwo) {
   EXPECT_EQ(RunClient({"detect", "--cloud", "x.pcd"}), 2);
   EXPECT_EQ(RunClient({"nonsense"}), 2);
   EXPECT_THAT(::testing::internal::GetCapturedStderr(), HasSubstr("--server is required"));
+}
+
+// The number of regular files in `dir` whose name ends in `ext`.
+int CountFiles(const std::string& dir, const std::string& ext) {
+  int n = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() == ext) ++n;
+  }
+  return n;
+}
+
+TEST(ClientTest, StreamPrintsAndWritesEveryFrameOfAPlayOnceSource) {
+  // 6 recorded frames played once: the stream ends by itself after the last.
+  std::unique_ptr<server::RunningServer> running =
+      StartLoopbackServer({{.name = "bin", .directory = kCartonFrames, .fps = 10, .loop = false}});
+  ASSERT_NE(running, nullptr);
+  const std::string json_dir = TempPath("client_stream_json");
+  const std::string png_dir = TempPath("client_stream_png");
+  std::filesystem::remove_all(json_dir);
+  std::filesystem::remove_all(png_dir);
+  ::testing::internal::CaptureStdout();
+  const int rc = RunClient({"stream", "--server", "127.0.0.1:" + std::to_string(running->port()),
+                            "--source", "bin", "--box", "carton_s", "--json", json_dir, "--png",
+                            png_dir, "--deadline_ms", "60000"});
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  ASSERT_EQ(rc, 0) << out;
+  // A slow client may skip frames (newest first), but it sees at least one,
+  // ids only increase, and every printed frame has its files.
+  EXPECT_THAT(out, HasSubstr("bin frame "));
+  const int jsons = CountFiles(json_dir, ".json");
+  EXPECT_GE(jsons, 1);
+  EXPECT_LE(jsons, 6);
+  EXPECT_EQ(CountFiles(png_dir, ".png"), jsons);
+  // The last frame is always delivered: a play-once source keeps it.
+  EXPECT_TRUE(std::filesystem::exists(json_dir + "/bin_6.json")) << out;
+  std::ifstream in(json_dir + "/bin_6.json");
+  const nlohmann::json json = nlohmann::json::parse(in);
+  EXPECT_GE(json["boxes"].size(), 1u);
+}
+
+TEST(ClientTest, StreamStopsAfterFramesOnALoopingSource) {
+  std::unique_ptr<server::RunningServer> running =
+      StartLoopbackServer({{.name = "bin", .directory = kCartonFrames, .fps = 20, .loop = true}});
+  ASSERT_NE(running, nullptr);
+  ::testing::internal::CaptureStdout();
+  const int rc = RunClient({"stream", "--server", "127.0.0.1:" + std::to_string(running->port()),
+                            "--source", "bin", "--box", "carton_s", "--frames", "2"});
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  EXPECT_EQ(rc, 0);
+  size_t frames = 0;
+  for (size_t at = out.find("bin frame "); at != std::string::npos;
+       at = out.find("bin frame ", at + 1)) {
+    ++frames;
+  }
+  EXPECT_EQ(frames, 2u) << out;
+}
+
+TEST(ClientTest, StreamFromUnknownSourceIsNotFound) {
+  std::unique_ptr<server::RunningServer> running = StartLoopbackServer();
+  ASSERT_NE(running, nullptr);
+  ::testing::internal::CaptureStderr();
+  const int rc = RunClient({"stream", "--server", "127.0.0.1:" + std::to_string(running->port()),
+                            "--source", "nope", "--box", "carton_s"});
+  EXPECT_EQ(rc, 1);
+  EXPECT_THAT(::testing::internal::GetCapturedStderr(), HasSubstr("NOT_FOUND"));
+}
+
+TEST(ClientTest, DetectOnASourceWritesTheFrameItDetectedOn) {
+  std::unique_ptr<server::RunningServer> running =
+      StartLoopbackServer({{.name = "bin", .directory = kCartonFrames, .fps = 5, .loop = true}});
+  ASSERT_NE(running, nullptr);
+  const std::string ply_path = TempPath("client_source.ply");
+  std::filesystem::remove(ply_path);
+  ::testing::internal::CaptureStdout();
+  const int rc =
+      RunClient({"detect", "--server", "127.0.0.1:" + std::to_string(running->port()), "--source",
+                 "bin", "--box", "carton_s", "--ply", ply_path, "--deadline_ms", "60000"});
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  ASSERT_EQ(rc, 0);
+  // The frame's cloud came back with it: a VGA frame's 307200 points.
+  EXPECT_THAT(out, HasSubstr("307200 points"));
+  EXPECT_GT(std::filesystem::file_size(ply_path), 307200u * 12);
+}
+
+TEST(ClientTest, SourcesListsStateAndHealthReportsServing) {
+  std::unique_ptr<server::RunningServer> running =
+      StartLoopbackServer({{.name = "bin", .directory = kCartonFrames, .fps = 5, .loop = true},
+                           {.name = "broken", .directory = "/nonexistent/frames"}});
+  ASSERT_NE(running, nullptr);
+  const std::string address = "127.0.0.1:" + std::to_string(running->port());
+  ::testing::internal::CaptureStdout();
+  EXPECT_EQ(RunClient({"sources", "--server", address}), 0);
+  EXPECT_EQ(RunClient({"health", "--server", address}), 0);
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  EXPECT_THAT(out, HasSubstr("bin  "));
+  EXPECT_THAT(out, HasSubstr("broken  FAILED"));
+  EXPECT_THAT(out, HasSubstr(": SERVING"));
+}
+
+TEST(ClientTest, HealthOfAStoppedServerIsExitCodeOne) {
+  int port = 0;
+  {
+    std::unique_ptr<server::RunningServer> running = StartLoopbackServer();
+    ASSERT_NE(running, nullptr);
+    port = running->port();
+    running->Shutdown();
+  }
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(RunClient({"health", "--server", "127.0.0.1:" + std::to_string(port), "--deadline_ms",
+                       "500"}),
+            1);
+  EXPECT_THAT(::testing::internal::GetCapturedStderr(), HasSubstr("cornerpose client health: "));
 }
 
 }  // namespace

@@ -50,6 +50,21 @@ TEST(DetectorOptionsFromRequestTest, ModelName) {
   EXPECT_EQ(options->box.h, 0.25);
 }
 
+TEST(DetectorOptionsFromRequestTest, ServerModelsComeBeforeBuiltInOnes) {
+  const BoxModels models = {{"crate", {0.5, 0.4, 0.3}}, {"carton_l", {0.41, 0.31, 0.26}}};
+  v1::DetectRequest request;
+  request.set_box_model("crate");
+  absl::StatusOr<DetectorOptions> crate = DetectorOptionsFromRequest(request, {}, models);
+  ASSERT_TRUE(crate.ok()) << crate.status();
+  EXPECT_EQ(crate->box.l, 0.5);
+  request.set_box_model("carton_l");
+  absl::StatusOr<DetectorOptions> carton = DetectorOptionsFromRequest(request, {}, models);
+  ASSERT_TRUE(carton.ok()) << carton.status();
+  EXPECT_EQ(carton->box.l, 0.41);
+  // Without the server's models the built-in size applies.
+  EXPECT_EQ(DetectorOptionsFromRequest(request, {})->box.l, 0.40);
+}
+
 TEST(DetectorOptionsFromRequestTest, RefusedBoxes) {
   struct Case {
     v1::DetectRequest request;

@@ -24,11 +24,14 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
+// Every server configuration shipped under deploy/: server*.textproto (the
+// daemon's robot_client*.textproto are tested with the daemon).
 std::vector<fs::path> DeployConfigs() {
   std::vector<fs::path> files;
   for (const fs::directory_entry& entry :
        fs::recursive_directory_iterator(fs::path(CORNERPOSE_SOURCE_DIR) / "deploy")) {
-    if (entry.is_regular_file() && entry.path().extension() == ".textproto") {
+    if (entry.is_regular_file() && entry.path().extension() == ".textproto" &&
+        entry.path().filename().string().rfind("server", 0) == 0) {
       files.push_back(entry.path());
     }
   }
@@ -57,7 +60,7 @@ std::vector<v1::Source> SettledSources(v1::PerceptionService::Stub& stub) {
 
 TEST(ServerConfigTest, EveryDeployConfigStartsAServerWithItsSources) {
   const std::vector<fs::path> files = DeployConfigs();
-  ASSERT_FALSE(files.empty()) << "no *.textproto under deploy/";
+  ASSERT_FALSE(files.empty()) << "no server*.textproto under deploy/";
   for (const fs::path& file : files) {
     SCOPED_TRACE(file.string());
     absl::StatusOr<ServerOptions> options = LoadServerConfig(file.string());
@@ -90,15 +93,21 @@ TEST(ServerConfigTest, ShippedConfigHasTheDocumentedValues) {
   EXPECT_EQ(options->listen_address, "0.0.0.0:50051");
   EXPECT_EQ(options->max_message_bytes, 64 * 1024 * 1024);
   EXPECT_EQ(options->max_concurrent_detections, 2);
-  ASSERT_EQ(options->sources.size(), 2u);
-  EXPECT_EQ(options->sources[0].name, "carton_s");
+  ASSERT_EQ(options->sources.size(), 3u);
+  // The demo cell's camera, which deploy/config/robot_client.textproto uses.
+  EXPECT_EQ(options->sources[0].name, "cell");
   EXPECT_TRUE(fs::equivalent(options->sources[0].directory,
-                             fs::path(CORNERPOSE_SOURCE_DIR) / "data/frames/carton_s"));
+                             fs::path(CORNERPOSE_SOURCE_DIR) / "data/frames/cell"));
   EXPECT_EQ(options->sources[0].fps, 5.0);
   EXPECT_TRUE(options->sources[0].loop);
-  EXPECT_EQ(options->sources[1].name, "brick");
-  EXPECT_EQ(options->sources[1].fps, 2.0);
+  EXPECT_EQ(options->sources[1].name, "carton_s");
+  EXPECT_TRUE(fs::equivalent(options->sources[1].directory,
+                             fs::path(CORNERPOSE_SOURCE_DIR) / "data/frames/carton_s"));
+  EXPECT_EQ(options->sources[1].fps, 5.0);
   EXPECT_TRUE(options->sources[1].loop);
+  EXPECT_EQ(options->sources[2].name, "brick");
+  EXPECT_EQ(options->sources[2].fps, 2.0);
+  EXPECT_TRUE(options->sources[2].loop);
 }
 
 // Writes `text` to a fresh file in the test's temporary directory.
@@ -142,6 +151,27 @@ TEST(ServerConfigTest, BadValuesAreInvalidArgument) {
         LoadServerConfig(WriteConfig("bad.textproto", text));
     EXPECT_EQ(options.status().code(), absl::StatusCode::kInvalidArgument) << text;
   }
+}
+
+TEST(ServerConfigTest, BoxModelsAndDetectorDefaultsReachTheOptions) {
+  const std::string path =
+      WriteConfig("models.textproto",
+                  "box_models { key: \"crate\" value { l: 0.5 b: 0.4 h: 0.3 } }\n"
+                  "detector_defaults { edge_threshold: 0.4 edge_radius_m: 0.02 }\n");
+  const absl::StatusOr<ServerOptions> options = LoadServerConfig(path);
+  ASSERT_TRUE(options.ok()) << options.status();
+  ASSERT_EQ(options->box_models.count("crate"), 1u);
+  EXPECT_EQ(options->box_models.at("crate").h, 0.3);
+  EXPECT_EQ(options->detector.edge_points.threshold, 0.4);
+  EXPECT_EQ(options->detector.edge_points.radius_m, 0.02);
+  // Untouched parameters keep the detector's defaults.
+  EXPECT_EQ(options->detector.segments.ransac_threshold_m,
+            DetectorOptions{}.segments.ransac_threshold_m);
+
+  const absl::StatusOr<ServerOptions> bad = LoadServerConfig(
+      WriteConfig("bad_defaults.textproto", "detector_defaults { edge_radius_m: -1 }\n"));
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(bad.status().message(), HasSubstr("detector_defaults"));
 }
 
 TEST(ServerConfigTest, UnsetFieldsTakeServerOptionsDefaults) {

@@ -20,6 +20,7 @@
 #include "common/perception/detector.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "grpc/health/v1/health.grpc.pb.h"
+#include "server/conversion.h"
 #include "tests/support/scene_generator.h"
 #include "tools/client/response_conversion.h"
 
@@ -51,7 +52,7 @@ const Frame& TheFrame() {
 
 v1::DetectRequest FrameRequest() {
   v1::DetectRequest request;
-  *request.mutable_cloud() = tools::CloudToProto(TheFrame().scene.cloud);
+  *request.mutable_cloud() = server::CloudToProto(TheFrame().scene.cloud);
   request.set_box_model("carton_s");
   return request;
 }
