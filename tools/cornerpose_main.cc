@@ -2,6 +2,8 @@
 //
 //   cornerpose detect --cloud FILE --box L,B,H|NAME --json OUT [--ply OUT] [--png OUT] ...
 //   cornerpose client detect --server ADDR --cloud FILE --box L,B,H|NAME [--json OUT] ...
+//   cornerpose client stream --server ADDR --source NAME --box L,B,H|NAME [--frames N] ...
+//   cornerpose client sources|health --server ADDR
 //
 // Run `cornerpose detect --help` for every option.
 #include <cstdio>
@@ -17,7 +19,7 @@ constexpr char kUsage[] =
     "usage: cornerpose <command> [options]\n"
     "commands:\n"
     "  detect   find edges, corners and box poses in a point cloud file\n"
-    "  client   send a point cloud file to a cornerpose server ('client detect')\n"
+    "  client   talk to a cornerpose server: detect, stream, sources, health\n"
     "run 'cornerpose <command> --help' for the options of a command\n";
 
 }  // namespace

@@ -2,7 +2,7 @@
 // generator: ray casting with a Kinect v1 noise model) into a directory of
 // recorded frames with exact ground truth.
 //
-//   make_frames --out DIR [--kind isolated|heap|pallet|mixed] [--count N]
+//   make_frames --out DIR [--kind isolated|heap|pallet|cell|mixed] [--count N]
 //               [--seed S] [--box NAME|L,B,H] [--pcd]
 //
 // Writes per frame NAME.png (16-bit depth, millimetres, 0 = no return) and,
@@ -63,6 +63,8 @@ int Run(const Args& a) {
       scene = testing::MakeIsolatedScene(*dims, 1 + i % 4, seed);
     } else if (kind == "heap") {
       scene = testing::MakeHeapScene(*dims, 6 + i % 8, seed);
+    } else if (kind == "cell") {
+      scene = testing::MakeCellScene(*dims, 5 + i % 4, seed);
     } else if (kind == "pallet") {
       scene = testing::MakePalletScene(*dims, 3 + i % 2, 2 + i % 3, 1 + i % 2,
                                        0.002 + 0.001 * (i % 3), i % 4, seed);
@@ -146,7 +148,7 @@ int main(int argc, char** argv) {
       ++i;
     } else {
       std::fprintf(stderr,
-                   "usage: make_frames --out DIR [--kind isolated|heap|pallet|mixed] [--count N] "
+                   "usage: make_frames --out DIR [--kind isolated|heap|pallet|cell|mixed] [--count N] "
                    "[--seed S] [--box NAME|L,B,H] [--pcd]\n");
       return 2;
     }

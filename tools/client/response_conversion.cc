@@ -15,19 +15,6 @@ Eigen::Vector3f ToEigenF(const v1::Vector3& v) { return ToEigen(v).cast<float>()
 
 }  // namespace
 
-v1::PointCloud CloudToProto(const PointCloud& cloud) {
-  v1::PointCloud msg;
-  std::string bytes(cloud.size() * 12, '\0');
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    const float p[3] = {cloud.xyz[i].x(), cloud.xyz[i].y(), cloud.xyz[i].z()};
-    std::memcpy(bytes.data() + i * 12, p, 12);  // little-endian hosts only (x86, arm)
-  }
-  msg.set_xyz(std::move(bytes));
-  msg.set_width(static_cast<uint32_t>(cloud.width));
-  msg.set_height(static_cast<uint32_t>(cloud.height));
-  return msg;
-}
-
 absl::StatusOr<BoxFace> BoxFaceFromProto(v1::BoxFace face) {
   switch (face) {
     case v1::BOX_FACE_PLUS_X:

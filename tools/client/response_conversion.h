@@ -1,6 +1,6 @@
-// The client side of the wire format: a cloud packed into a request, and a
-// DetectResponse converted back into the detector's types. server/conversion.h
-// goes the other way (proto -> cloud, Detection -> proto).
+// The client side of the wire format: a DetectResponse converted back into
+// the detector's types (server/conversion.h goes the other way, and packs
+// clouds for both sides).
 #pragma once
 
 #include "absl/status/statusor.h"
@@ -9,10 +9,6 @@
 #include "cornerpose/v1/perception_service.pb.h"
 
 namespace cornerpose::tools {
-
-// Packs xyz as little-endian float32 triples, keeping width x height (and
-// the NaNs of an organized cloud). The inverse of server::CloudFromProto.
-v1::PointCloud CloudToProto(const PointCloud& cloud);
 
 // The inverse of server::ToProto(BoxFace). INVALID_ARGUMENT for
 // BOX_FACE_UNSPECIFIED or an unknown value.

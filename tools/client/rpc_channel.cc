@@ -1,0 +1,31 @@
+#include "tools/client/rpc_channel.h"
+
+#include <grpcpp/create_channel.h>
+#include <grpcpp/security/credentials.h>
+#include <grpcpp/support/channel_arguments.h>
+
+#include "absl/strings/str_cat.h"
+
+namespace cornerpose::tools {
+
+std::shared_ptr<grpc::Channel> MakeChannel(const std::string& server) {
+  grpc::ChannelArguments channel_args;
+  channel_args.SetMaxReceiveMessageSize(-1);
+  channel_args.SetMaxSendMessageSize(-1);
+  return grpc::CreateCustomChannel(server, grpc::InsecureChannelCredentials(), channel_args);
+}
+
+absl::Status FromRpcStatus(const grpc::Status& rpc, grpc::Channel& channel,
+                           const std::string& server, int deadline_ms) {
+  if (rpc.ok()) return absl::OkStatus();
+  std::string message = rpc.error_message();
+  if ((rpc.error_code() == grpc::StatusCode::UNAVAILABLE ||
+       rpc.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED) &&
+      channel.GetState(false) != GRPC_CHANNEL_READY) {
+    message =
+        absl::StrCat("cannot reach server ", server, " (deadline ", deadline_ms, " ms): ", message);
+  }
+  return absl::Status(static_cast<absl::StatusCode>(rpc.error_code()), message);
+}
+
+}  // namespace cornerpose::tools
