@@ -239,6 +239,14 @@ Scene MakeHeapScene(const BoxDims& dims, int num_boxes, uint32_t seed) {
   return scene;
 }
 
+Scene MakeCellScene(const BoxDims& dims, int num_boxes, uint32_t seed) {
+  Scene scene = MakeHeapScene(dims, num_boxes, seed);
+  scene.world_T_camera =
+      LookAtCamera(Eigen::Vector3d::Zero(), kCellCameraHeight, /*tilt_deg=*/0.0, /*yaw_deg=*/0.0,
+                   /*roll_deg=*/0.0);
+  return scene;
+}
+
 Scene MakePalletScene(const BoxDims& dims, int rows, int cols, int layers, double gap_m,
                       int removed_top, uint32_t seed) {
   std::mt19937 rng(seed);

@@ -139,6 +139,13 @@ Scene MakeIsolatedScene(const BoxDims& dims, int num_boxes, uint32_t seed);
 // lowest centre kept). No two boxes interpenetrate.
 Scene MakeHeapScene(const BoxDims& dims, int num_boxes, uint32_t seed);
 
+// The demo cell's view: a heap (as MakeHeapScene) around the world origin
+// seen by a camera fixed kCellCameraHeight straight above the origin
+// (image x = world +x, image y = world -y), the mounting the robot cell's
+// hand-eye calibration (deploy/config/robot_client.textproto) describes.
+inline constexpr double kCellCameraHeight = 1.3;
+Scene MakeCellScene(const BoxDims& dims, int num_boxes, uint32_t seed);
+
 // A rows x cols x layers grid on a EUR pallet, l along the pallet length,
 // gap_m between boxes, +-2 mm / +-0.6 deg jitter; removed_top boxes of the top
 // layer are taken away row by row from a corner.
