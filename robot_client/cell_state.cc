@@ -1,5 +1,6 @@
 #include "robot_client/cell_state.h"
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 
 namespace cornerpose::robot_client {
@@ -39,17 +40,20 @@ const char* PickOutcomeName(PickOutcome outcome) {
 }
 
 std::string DescribePick(const PickRecord& pick) {
-  const Eigen::Vector3d g = pick.plan.grasp.translation();
-  const Eigen::Vector3d f = pick.plan.place.translation();
+  const auto xyz = [](const Eigen::Isometry3d& pose) {
+    const Eigen::Vector3d p = pose.translation();
+    return absl::StrFormat("(%.3f, %.3f, %.3f)", p.x(), p.y(), p.z());
+  };
   std::string line = absl::StrFormat(
-      "pick %d %s: %s#%d score %.2f, grasp G (%.3f, %.3f, %.3f) -> slot %d F (%.3f, %.3f, "
-      "%.3f): %s (plan %.1f ms, program %.1f s)",
-      pick.pick_id, pick.program_name, pick.source, pick.frame_id, pick.score, g.x(), g.y(), g.z(),
-      pick.plan.slot, f.x(), f.y(), f.z(), PickOutcomeName(pick.outcome), pick.plan_ms,
-      pick.program_s);
+      "pick %d %s: %s#%d box at %s score %.2f -> slot %d: %s (plan %.1f ms, program %.1f s)",
+      pick.pick_id, pick.program_name, pick.source, pick.frame_id, xyz(pick.plan.box.base_T_box),
+      pick.score, pick.plan.slot, PickOutcomeName(pick.outcome), pick.plan_ms, pick.program_s);
   if (pick.outcome != PickOutcome::kCompleted && !pick.detail.empty()) {
     absl::StrAppend(&line, ": ", pick.detail);
   }
+  absl::StrAppend(&line, "\n    I ", xyz(pick.plan.initial), "  M ", xyz(pick.plan.approach),
+                  "  G ", xyz(pick.plan.grasp), "  R ", xyz(pick.plan.retrieve), "  F ",
+                  xyz(pick.plan.place));
   return line;
 }
 

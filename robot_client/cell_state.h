@@ -55,8 +55,9 @@ struct PickRecord {
   absl::Time start_time;
 };
 
-// One line for the log: "pick 3 pick_0003 carton_s#12 score 0.93 G (x, y, z)
-// -> slot 2: COMPLETED in 7.9 s".
+// Two lines for the log: "pick 3 pick_0003: cell#12 box at (x, y, z) score
+// 0.93 -> slot 2: COMPLETED (plan 0.2 ms, program 7.9 s)" and the positions
+// of the waypoints I, M, G, R, F (base frame, metres).
 std::string DescribePick(const PickRecord& pick);
 
 }  // namespace cornerpose::robot_client
