@@ -66,6 +66,9 @@ bool PerceptionSubscriber::SleepUnlessStopped(absl::Duration d) {
 void PerceptionSubscriber::Run() {
   grpc::ChannelArguments channel_args;
   channel_args.SetMaxReceiveMessageSize(-1);
+  // A reconnecting stream lands on any replica the name resolves to (a
+  // headless Kubernetes Service lists each one).
+  channel_args.SetLoadBalancingPolicyName("round_robin");
   // Reconnect quickly when the service comes back.
   channel_args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS,
                       static_cast<int>(absl::ToInt64Milliseconds(options_.max_backoff)));

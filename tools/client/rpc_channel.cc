@@ -12,6 +12,9 @@ std::shared_ptr<grpc::Channel> MakeChannel(const std::string& server) {
   grpc::ChannelArguments channel_args;
   channel_args.SetMaxReceiveMessageSize(-1);
   channel_args.SetMaxSendMessageSize(-1);
+  // Per-call balancing over every address the name resolves to (a headless
+  // Kubernetes Service lists each replica; see deploy/k8s/service.yaml).
+  channel_args.SetLoadBalancingPolicyName("round_robin");
   return grpc::CreateCustomChannel(server, grpc::InsecureChannelCredentials(), channel_args);
 }
 

@@ -13,8 +13,10 @@
 
 namespace cornerpose::tools {
 
-// An insecure channel to host:port, sending and receiving messages of any
-// size (full frames exceed gRPC's 4 MiB default).
+// An insecure channel to host:port (or any gRPC target, e.g.
+// dns:///name:port), sending and receiving messages of any size (full frames
+// exceed gRPC's 4 MiB default), balancing calls round robin over the
+// addresses the name resolves to.
 std::shared_ptr<grpc::Channel> MakeChannel(const std::string& server);
 
 // The RPC's status as an absl::Status (the codes share their values); when
