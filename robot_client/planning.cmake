@@ -15,5 +15,5 @@ target_include_directories(cornerpose_robot_planning PUBLIC ${PROJECT_SOURCE_DIR
 target_link_libraries(cornerpose_robot_planning
   PUBLIC cornerpose_ur cornerpose_perception Eigen3::Eigen absl::status absl::statusor
          absl::strings
-  PRIVATE cornerpose_proto absl::str_format)
+  PRIVATE cornerpose_config cornerpose_proto absl::str_format)
 cornerpose_warnings(cornerpose_robot_planning)

@@ -1,17 +1,11 @@
 #include "robot_client/robot_config.h"
 
-#include <google/protobuf/io/tokenizer.h>
-#include <google/protobuf/text_format.h>
-
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
-#include <system_error>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "common/config/text_proto_file.h"
 #include "common/perception/box_models.h"
 #include "cornerpose/v1/robot_client_config.pb.h"
 
@@ -53,21 +47,6 @@ absl::Status CheckRigid(absl::string_view field, const Eigen::Isometry3d& T) {
 std::string Xyz(const Eigen::Vector3d& p) {
   return absl::StrFormat("(%.4f, %.4f, %.4f)", p.x(), p.y(), p.z());
 }
-
-// Keeps the parser's errors (it logs them otherwise) as "line:column: message",
-// 1-based.
-class CollectErrors : public google::protobuf::io::ErrorCollector {
- public:
-  void AddError(int line, google::protobuf::io::ColumnNumber column,
-                const std::string& message) override {
-    if (!errors_.empty()) errors_ += "; ";
-    absl::StrAppend(&errors_, line + 1, ":", column + 1, ": ", message);
-  }
-  const std::string& errors() const { return errors_; }
-
- private:
-  std::string errors_;
-};
 
 Eigen::Vector3d ToEigen(const v1::Vector3& v) { return {v.x(), v.y(), v.z()}; }
 
@@ -398,26 +377,8 @@ absl::Status RobotClientOptions::Validate() const {
 }
 
 absl::StatusOr<RobotClientOptions> LoadRobotClientConfig(const std::string& path) {
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
-    if (std::filesystem::exists(path, error)) {
-      return Invalid(absl::StrCat(path, ": not a regular file"));
-    }
-    return absl::NotFoundError(absl::StrCat("configuration file not found: ", path));
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return absl::NotFoundError(absl::StrCat("cannot open configuration file: ", path));
-  std::ostringstream text;
-  text << in.rdbuf();
-
   v1::RobotClientConfig config;
-  CollectErrors errors;
-  google::protobuf::TextFormat::Parser parser;
-  parser.RecordErrorsTo(&errors);
-  if (!parser.ParseFromString(text.str(), &config)) {
-    return Invalid(
-        absl::StrCat(path, ": ", errors.errors().empty() ? "cannot parse" : errors.errors()));
-  }
+  if (absl::Status s = ReadTextProtoFile(path, &config); !s.ok()) return s;
   absl::StatusOr<RobotClientOptions> options = FromProto(config);
   if (!options.ok()) return Invalid(absl::StrCat(path, ": ", options.status().message()));
   if (absl::Status s = options->Validate(); !s.ok()) {

@@ -62,65 +62,32 @@ absl::StatusOr<CameraIntrinsics> ReadIntrinsics(const std::string& directory) {
 
 DirectorySource::DirectorySource(std::string name, std::string directory,
                                  DirectorySourceOptions options)
-    : name_(std::move(name)), directory_(std::move(directory)), options_(options) {
+    : name_(std::move(name)),
+      directory_(std::move(directory)),
+      options_(options),
+      frames_(absl::StrCat("source '", name_, "'")) {
   thread_ = std::thread([this] { Run(); });
 }
 
 DirectorySource::~DirectorySource() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stopping_ = true;
-  }
-  changed_.notify_all();
+  frames_.Stop();
   thread_.join();
 }
 
 absl::StatusOr<Frame> DirectorySource::GrabNewerThan(uint64_t last_id, absl::Duration timeout) {
-  std::unique_lock<std::mutex> lock(mutex_);
-  const auto ready = [&] {
-    return stopping_ || status_.state == SourceState::kFailed ||
-           status_.state == SourceState::kFinished || (newest_ && newest_->id > last_id);
-  };
-  changed_.wait_for(lock, absl::ToChronoNanoseconds(std::max(timeout, absl::ZeroDuration())),
-                    ready);
-  if (status_.state == SourceState::kFailed) {
-    return absl::UnavailableError(absl::StrCat("source '", name_, "' failed: ", status_.reason));
-  }
-  if (newest_ && newest_->id > last_id) return *newest_;
-  if (status_.state == SourceState::kFinished) {
-    return absl::OutOfRangeError(absl::StrCat("source '", name_, "' finished"));
-  }
-  if (stopping_) return absl::UnavailableError(absl::StrCat("source '", name_, "' stopped"));
-  return absl::UnavailableError(absl::StrCat("no new frame from source '", name_, "' within ",
-                                             absl::FormatDuration(timeout)));
+  return frames_.GrabNewerThan(last_id, timeout);
 }
 
-SourceStatus DirectorySource::state() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return status_;
-}
-
-void DirectorySource::SetState(SourceState state, std::string reason) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    status_ = {state, std::move(reason)};
-  }
-  changed_.notify_all();
-}
-
-bool DirectorySource::SleepFor(absl::Duration duration) {
-  std::unique_lock<std::mutex> lock(mutex_);
-  return !changed_.wait_for(lock, absl::ToChronoNanoseconds(duration), [&] { return stopping_; });
-}
+SourceStatus DirectorySource::state() const { return frames_.state(); }
 
 void DirectorySource::Run() {
   if (!(options_.fps > 0)) {
-    SetState(SourceState::kFailed, absl::StrCat("fps ", options_.fps, " must be > 0"));
+    frames_.SetState(SourceState::kFailed, absl::StrCat("fps ", options_.fps, " must be > 0"));
     return;
   }
   absl::StatusOr<Listing> listing = ListFrames(directory_);
   if (!listing.ok()) {
-    SetState(SourceState::kFailed, std::string(listing.status().message()));
+    frames_.SetState(SourceState::kFailed, std::string(listing.status().message()));
     return;
   }
   // Depth images need the camera; without it every PNG is skipped (and the
@@ -157,21 +124,16 @@ void DirectorySource::Run() {
       frame.id = next_id++;
       frame.capture_time = absl::Now();
       frame.source = name_;
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        newest_ = std::move(frame);
-        status_ = {SourceState::kRunning, ""};
-      }
-      changed_.notify_all();
-      if (!SleepFor(period)) return;
+      frames_.Publish(std::move(frame));
+      if (!frames_.SleepFor(period)) return;
     }
     if (!any_loaded) {
-      SetState(SourceState::kFailed,
-               absl::StrCat("no frame in '", directory_, "' could be loaded; last: ", last_error));
+      frames_.SetState(SourceState::kFailed, absl::StrCat("no frame in '", directory_,
+                                                          "' could be loaded; last: ", last_error));
       return;
     }
     if (!options_.loop) {
-      SetState(SourceState::kFinished, "played every frame once");
+      frames_.SetState(SourceState::kFinished, "played every frame once");
       return;
     }
   }

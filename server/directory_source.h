@@ -3,14 +3,12 @@
 // streaming path and the tests run without a camera.
 #pragma once
 
-#include <condition_variable>
-#include <mutex>
-#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "server/frame_source.h"
+#include "server/latest_frame.h"
 
 namespace cornerpose::server {
 
@@ -45,20 +43,12 @@ class DirectorySource final : public FrameSource {
 
  private:
   void Run();
-  // Sets the state unless stopping; wakes every waiter.
-  void SetState(SourceState state, std::string reason);
-  // Waits `duration` or until stopping; false when stopping.
-  bool SleepFor(absl::Duration duration);
 
   const std::string name_;
   const std::string directory_;
   const DirectorySourceOptions options_;
 
-  mutable std::mutex mutex_;
-  std::condition_variable changed_;
-  std::optional<Frame> newest_;  // guarded by mutex_
-  SourceStatus status_;          // guarded by mutex_
-  bool stopping_ = false;        // guarded by mutex_
+  LatestFrame frames_;
   std::thread thread_;
 };
 

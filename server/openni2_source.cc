@@ -110,16 +110,15 @@ absl::StatusOr<Frame> ToFrame(const openni::VideoFrameRef& ref, float hfov, floa
 }  // namespace
 
 OpenNi2Source::OpenNi2Source(std::string name, std::string uri, OpenNi2SourceOptions options)
-    : name_(std::move(name)), uri_(std::move(uri)), options_(options) {
+    : name_(std::move(name)),
+      uri_(std::move(uri)),
+      options_(options),
+      frames_(absl::StrCat("source '", name_, "' (", description(), ")")) {
   thread_ = std::thread([this] { Run(); });
 }
 
 OpenNi2Source::~OpenNi2Source() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stopping_ = true;
-  }
-  changed_.notify_all();
+  frames_.Stop();
   thread_.join();
 }
 
@@ -128,68 +127,24 @@ std::string OpenNi2Source::description() const {
 }
 
 absl::StatusOr<Frame> OpenNi2Source::GrabNewerThan(uint64_t last_id, absl::Duration timeout) {
-  std::unique_lock<std::mutex> lock(mutex_);
-  const auto ready = [&] {
-    return stopping_ || status_.state == SourceState::kFailed ||
-           status_.state == SourceState::kFinished || (newest_ && newest_->id > last_id);
-  };
-  changed_.wait_for(lock, absl::ToChronoNanoseconds(std::max(timeout, absl::ZeroDuration())),
-                    ready);
-  if (status_.state == SourceState::kFailed) {
-    return absl::UnavailableError(
-        absl::StrCat("source '", name_, "' (", description(), ") failed: ", status_.reason));
-  }
-  if (newest_ && newest_->id > last_id) return *newest_;
-  if (status_.state == SourceState::kFinished) {
-    return absl::OutOfRangeError(absl::StrCat("source '", name_, "' finished"));
-  }
-  if (stopping_) return absl::UnavailableError(absl::StrCat("source '", name_, "' stopped"));
-  return absl::UnavailableError(absl::StrCat("no new frame from source '", name_, "' within ",
-                                             absl::FormatDuration(timeout)));
+  return frames_.GrabNewerThan(last_id, timeout);
 }
 
-SourceStatus OpenNi2Source::state() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return status_;
-}
-
-void OpenNi2Source::SetState(SourceState state, std::string reason) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (stopping_) return;
-    status_ = {state, std::move(reason)};
-  }
-  changed_.notify_all();
-}
+SourceStatus OpenNi2Source::state() const { return frames_.state(); }
 
 void OpenNi2Source::Publish(Frame frame) {
   frame.id = next_id_++;
   frame.capture_time = absl::Now();
   frame.source = name_;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    newest_ = std::move(frame);
-    status_ = {SourceState::kRunning, ""};
-  }
-  changed_.notify_all();
+  frames_.Publish(std::move(frame));
   delivered_ = true;
-}
-
-bool OpenNi2Source::Stopping() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return stopping_;
-}
-
-bool OpenNi2Source::SleepFor(absl::Duration duration) {
-  std::unique_lock<std::mutex> lock(mutex_);
-  return !changed_.wait_for(lock, absl::ToChronoNanoseconds(duration), [&] { return stopping_; });
 }
 
 void OpenNi2Source::Run() {
   if (options_.recording &&
       !(options_.playback_speed > 0 && std::isfinite(options_.playback_speed))) {
-    SetState(SourceState::kFailed,
-             absl::StrCat("playback speed ", options_.playback_speed, " must be > 0"));
+    frames_.SetState(SourceState::kFailed,
+                     absl::StrCat("playback speed ", options_.playback_speed, " must be > 0"));
     return;
   }
   absl::Duration delay = options_.retry_delay;
@@ -199,15 +154,15 @@ void OpenNi2Source::Run() {
     const SessionEnd end = Capture(&reason);
     if (end == SessionEnd::kStopping) return;
     if (end == SessionEnd::kFinished) {
-      SetState(SourceState::kFinished, "played the recording once");
+      frames_.SetState(SourceState::kFinished, "played the recording once");
       return;
     }
     if (delivered_) delay = options_.retry_delay;
     reason = absl::StrCat(reason, " (attempt ", attempt, "; retrying in ",
                           absl::FormatDuration(delay), ")");
     std::cerr << "source " << name_ << ": " << reason << "\n";
-    SetState(SourceState::kFailed, std::move(reason));
-    if (!SleepFor(delay)) return;
+    frames_.SetState(SourceState::kFailed, std::move(reason));
+    if (!frames_.SleepFor(delay)) return;
     delay = std::min(delay * 2, std::max(options_.retry_max_delay, options_.retry_delay));
   }
 }
@@ -265,7 +220,7 @@ OpenNi2Source::SessionEnd OpenNi2Source::Capture(std::string* reason) {
 
   absl::Time last_frame = absl::Now();
   bool any_frame = false;
-  while (!Stopping()) {
+  while (!frames_.stopping()) {
     openni::VideoStream* streams[] = {&depth};
     int ready = -1;
     if (openni::OpenNI::waitForAnyStream(streams, 1, &ready, kPollMilliseconds) !=

@@ -4,15 +4,13 @@
 // plays back as a device.
 #pragma once
 
-#include <condition_variable>
-#include <mutex>
-#include <optional>
 #include <string>
 #include <thread>
 
 #include "absl/status/status.h"
 #include "absl/time/time.h"
 #include "server/frame_source.h"
+#include "server/latest_frame.h"
 
 namespace cornerpose::server {
 
@@ -67,23 +65,16 @@ class OpenNi2Source final : public FrameSource {
   // Opens the device and captures until stopped, finished or failed; a
   // failure's reason goes to *reason.
   SessionEnd Capture(std::string* reason);
-  void SetState(SourceState state, std::string reason);
+  // Numbers, stamps and publishes a captured frame.
   void Publish(Frame frame);
-  bool Stopping() const;
-  // Waits `duration` or until stopping; false when stopping.
-  bool SleepFor(absl::Duration duration);
 
   const std::string name_;
   const std::string uri_;
   const OpenNi2SourceOptions options_;
 
-  mutable std::mutex mutex_;
-  std::condition_variable changed_;
-  std::optional<Frame> newest_;  // guarded by mutex_
-  SourceStatus status_;          // guarded by mutex_
-  bool stopping_ = false;        // guarded by mutex_
-  uint64_t next_id_ = 1;         // capture thread only
-  bool delivered_ = false;       // capture thread only: a frame since the last failure
+  LatestFrame frames_;
+  uint64_t next_id_ = 1;    // capture thread only
+  bool delivered_ = false;  // capture thread only: a frame since the last failure
   std::thread thread_;
 };
 

@@ -1,39 +1,19 @@
 #include "server/server_config.h"
 
-#include <google/protobuf/io/tokenizer.h>
-#include <google/protobuf/text_format.h>
-
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <set>
-#include <sstream>
 #include <string>
-#include <system_error>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "common/config/text_proto_file.h"
 #include "cornerpose/v1/server_config.pb.h"
 #include "server/detect_request.h"
 
 namespace cornerpose::server {
 namespace {
-
-// Keeps the parser's errors (it logs them otherwise) as "line:column: message",
-// 1-based.
-class CollectErrors : public google::protobuf::io::ErrorCollector {
- public:
-  void AddError(int line, google::protobuf::io::ColumnNumber column,
-                const std::string& message) override {
-    if (!errors_.empty()) errors_ += "; ";
-    absl::StrAppend(&errors_, line + 1, ":", column + 1, ": ", message);
-  }
-  const std::string& errors() const { return errors_; }
-
- private:
-  std::string errors_;
-};
 
 absl::Status Invalid(const std::string& path, const std::string& message) {
   return absl::InvalidArgumentError(absl::StrCat(path, ": ", message));
@@ -42,25 +22,8 @@ absl::Status Invalid(const std::string& path, const std::string& message) {
 }  // namespace
 
 absl::StatusOr<ServerOptions> LoadServerConfig(const std::string& path) {
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
-    if (std::filesystem::exists(path, error)) {
-      return Invalid(path, "not a regular file");
-    }
-    return absl::NotFoundError(absl::StrCat("configuration file not found: ", path));
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return absl::NotFoundError(absl::StrCat("cannot open configuration file: ", path));
-  std::ostringstream text;
-  text << in.rdbuf();
-
   v1::ServerConfig config;
-  CollectErrors errors;
-  google::protobuf::TextFormat::Parser parser;
-  parser.RecordErrorsTo(&errors);
-  if (!parser.ParseFromString(text.str(), &config)) {
-    return Invalid(path, errors.errors().empty() ? "cannot parse" : errors.errors());
-  }
+  if (absl::Status s = ReadTextProtoFile(path, &config); !s.ok()) return s;
 
   ServerOptions options;
   if (!config.listen_address().empty()) options.listen_address = config.listen_address();
