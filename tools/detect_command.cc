@@ -111,10 +111,12 @@ absl::Status Run(const CommandArgs& args) {
 
 }  // namespace
 
-void PrintDetection(const std::string& label, size_t num_points, const Detection& detection) {
+void PrintDetection(const std::string& label, std::optional<size_t> num_points,
+                    const Detection& detection) {
   const Detection* det = &detection;
-  std::printf("%s: %zu points, %zu edge points, %zu segments, %zu corners, %zu boxes (%.1f ms)\n",
-              label.c_str(), num_points, det->edge_points.size(), det->segments.size(),
+  const std::string points = num_points ? absl::StrCat(*num_points, " points, ") : "";
+  std::printf("%s: %s%zu edge points, %zu segments, %zu corners, %zu boxes (%.1f ms)\n",
+              label.c_str(), points.c_str(), det->edge_points.size(), det->segments.size(),
               det->corners.size(), det->boxes.size(), det->timings.total_ms);
   for (size_t i = 0; i < det->boxes.size(); ++i) {
     const DetectedBox& b = det->boxes[i];

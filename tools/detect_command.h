@@ -2,6 +2,7 @@
 // results as JSON, a coloured PLY and a PNG.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,9 @@ int RunDetect(const std::vector<std::string>& args);
 
 // Prints the summary line ("<label>: N points, ... boxes (T ms)") and one
 // line per box, as `cornerpose detect` does (shared with `cornerpose client`).
-void PrintDetection(const std::string& label, size_t num_points, const Detection& detection);
+// num_points: the cloud's size, or nullopt when it is not known here (a
+// server-side frame whose cloud was not fetched).
+void PrintDetection(const std::string& label, std::optional<size_t> num_points,
+                    const Detection& detection);
 
 }  // namespace cornerpose::tools

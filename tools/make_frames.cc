@@ -147,9 +147,10 @@ int main(int argc, char** argv) {
     } else if (k == "--seed" && has_value && absl::SimpleAtoi(argv[i + 1], &a.seed)) {
       ++i;
     } else {
-      std::fprintf(stderr,
-                   "usage: make_frames --out DIR [--kind isolated|heap|pallet|cell|mixed] [--count N] "
-                   "[--seed S] [--box NAME|L,B,H] [--pcd]\n");
+      std::fprintf(
+          stderr,
+          "usage: make_frames --out DIR [--kind isolated|heap|pallet|cell|mixed] [--count N] "
+          "[--seed S] [--box NAME|L,B,H] [--pcd]\n");
       return 2;
     }
   }

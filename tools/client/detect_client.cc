@@ -106,7 +106,11 @@ absl::Status Detect(const CommandArgs& args) {
     }
     cloud = *std::move(frame_cloud);
   }
-  if (!args.Has("quiet")) PrintDetection(label, cloud.size(), *det);
+  if (!args.Has("quiet")) {
+    // A source's cloud is only fetched when an output draws on it.
+    const bool have_cloud = cloud_path.has_value() || response.has_cloud();
+    PrintDetection(label, have_cloud ? std::optional<size_t>(cloud.size()) : std::nullopt, *det);
+  }
   return WriteDetectionOutputs(common->outputs, cloud, intrinsics, *det, common->box);
 }
 

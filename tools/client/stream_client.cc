@@ -104,7 +104,8 @@ absl::Status Stream(const CommandArgs& args) {
           absl::StrCat("bad cloud from ", common->server, ": ", cloud.status().message()));
     }
     if (!args.Has("quiet")) {
-      PrintDetection(absl::StrCat(response.source(), " frame ", response.frame_id()), cloud->size(),
+      PrintDetection(absl::StrCat(response.source(), " frame ", response.frame_id()),
+                     response.has_cloud() ? std::optional<size_t>(cloud->size()) : std::nullopt,
                      *det);
       std::fflush(stdout);
     }
