@@ -118,6 +118,14 @@ void CellController::Record(PickRecord record) {
   if (callbacks_.on_pick) callbacks_.on_pick(record);
 }
 
+bool CellController::SuctionOn(const ur::RtdeState& state) const {
+  // RTDE's output word: standard outputs in bits 0-7, tool outputs from 16.
+  const int bit = options_.gripper.suction_output == SuctionOutputKind::kTool
+                      ? 16 + options_.gripper.suction_output_index
+                      : options_.gripper.suction_output_index;
+  return (state.digital_outputs >> bit) & 1u;
+}
+
 bool CellController::RobotReady() {
   if (options_.dry_run) return true;
   if (!link_.connected()) {
@@ -136,6 +144,16 @@ bool CellController::RobotReady() {
   absl::StatusOr<ur::RtdeState> state = link_.State();
   if (!state.ok()) {
     SetState(CellState::kStopped, absl::StrCat("no robot state: ", state.status().message()));
+    Pause(controller_.retry_interval);
+    return false;
+  }
+  // A pick cut short (a protective stop, say) can leave the vacuum on and a
+  // box on the cup; the next program would carry it into the pile. That is
+  // for an operator to clear: wait until the output is off.
+  if (SuctionOn(*state)) {
+    SetState(CellState::kStopped,
+             "the suction output is on with no pick running (a box may still be on the "
+             "gripper): clear it and switch the output off");
     Pause(controller_.retry_interval);
     return false;
   }

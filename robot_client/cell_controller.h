@@ -69,6 +69,8 @@ class CellController {
   bool Step();
   // Whether the robot can take a program now; sets STOPPED and waits when not.
   bool RobotReady();
+  // Whether the gripper's suction output is on in `state`.
+  bool SuctionOn(const ur::RtdeState& state) const;
   void SetState(CellState state, const std::string& reason = "");
   void Record(PickRecord record);
   // Sleeps up to `d` unless stopped.

@@ -349,6 +349,20 @@ TEST_F(CellTest, ProtectiveStopHaltsThePickAndAReleaseResumes) {
   }
   ASSERT_TRUE(released);
 
+  // The box is still on the cup: the cell stays stopped until the operator
+  // has cleared it and switched the vacuum off (here from the controller,
+  // as from its teach pendant).
+  ASSERT_TRUE(WaitForStatus(
+      [](const v1::CellStatus& s) {
+        return s.state() == v1::CELL_STATE_STOPPED &&
+               s.stop_reason().find("suction output is on") != std::string::npos;
+      },
+      absl::Seconds(10), &status))
+      << status.DebugString();
+  EXPECT_EQ(emulator_->Snapshot().programs_recorded, programs_at_stop);
+  emulator_->controller().SubmitScript(
+      "def operator_clear():\n  set_tool_digital_out(0, False)\nend\n");
+
   ASSERT_TRUE(
       WaitForStatus([](const v1::CellStatus& s) { return s.state() == v1::CELL_STATE_FINISHED; },
                     absl::Seconds(120), &status))
@@ -364,8 +378,9 @@ TEST_F(CellTest, ProtectiveStopHaltsThePickAndAReleaseResumes) {
   // The stopped pick did not take the slot: the next pick goes to slot 0.
   EXPECT_EQ(picks[1].slot(), 0u);
   const std::vector<ur_emulator::ExecutedProgram> programs = emulator_->Programs();
-  ASSERT_EQ(programs.size(), 3u);
+  ASSERT_EQ(programs.size(), 4u);  // the two picks around the operator's program
   EXPECT_EQ(programs[0].outcome, ur_emulator::ProgramOutcome::kProtectiveStop);
+  EXPECT_EQ(programs[1].name, "operator_clear");
 }
 
 TEST_F(CellTest, LostPerceptionStreamStopsTheCellUntilTheServiceReturns) {
