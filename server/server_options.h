@@ -27,10 +27,10 @@ struct SourceSpec {
   std::string name;
   SourceKind kind = SourceKind::kDirectory;
   // kDirectory: the directory.
-  std::string directory;
+  std::string directory{};
   // kOpenNi2Device: the device URI ("" = the first device OpenNI2 lists);
   // kOniFile: the .oni file.
-  std::string uri;
+  std::string uri{};
   // kDirectory: frames per second of the replay; > 0.
   double fps = 5.0;
   // kDirectory and kOniFile: replay forever (true) or once.

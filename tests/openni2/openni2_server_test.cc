@@ -16,6 +16,7 @@
 #include "server/server.h"
 #include "server/source_spec.h"
 #include "tests/openni2/openni2_test_support.h"
+#include "tests/server/source_server_fixture.h"
 
 namespace cornerpose::server {
 namespace {
@@ -25,7 +26,7 @@ using openni2_test::CartonFrames;
 using openni2_test::VirtualCameraUri;
 using ::testing::HasSubstr;
 
-class OpenNi2ServerTest : public ::testing::Test {
+class OpenNi2ServerTest : public testing::SourceServerFixture {
  protected:
   static void SetUpTestSuite() {
     recording_ = new std::string(
@@ -43,7 +44,6 @@ class OpenNi2ServerTest : public ::testing::Test {
   void SetUp() override {
     ASSERT_EQ(*record_error_, "");
     ServerOptions options;
-    options.listen_address = "127.0.0.1:0";
     for (const std::string& flag :
          {"rec=oni:" + *recording_ + ":loop", "cam=openni2:" + VirtualCameraUri(CartonFrames(), 10),
           "gone=openni2:" + VirtualCameraUri("/nonexistent/frames", 10),
@@ -52,55 +52,11 @@ class OpenNi2ServerTest : public ::testing::Test {
       ASSERT_TRUE(spec.ok()) << spec.status();
       options.sources.push_back(*spec);
     }
-    absl::StatusOr<std::unique_ptr<RunningServer>> server = StartServer(options);
-    ASSERT_TRUE(server.ok()) << server.status();
-    server_ = *std::move(server);
-    grpc::ChannelArguments args;
-    args.SetMaxReceiveMessageSize(-1);
-    stub_ = v1::PerceptionService::NewStub(grpc::CreateCustomChannel(
-        "127.0.0.1:" + std::to_string(server_->port()), grpc::InsecureChannelCredentials(), args));
-  }
-
-  v1::ListSourcesResponse ListSources() {
-    grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
-    v1::ListSourcesResponse response;
-    grpc::Status s = stub_->ListSources(&context, v1::ListSourcesRequest(), &response);
-    EXPECT_TRUE(s.ok()) << s.error_message();
-    return response;
-  }
-
-  // Polls ListSources until `name` leaves STARTING (or 20 s pass).
-  v1::Source WaitForSource(const std::string& name) {
-    v1::Source found;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-    while (std::chrono::steady_clock::now() < deadline) {
-      const v1::ListSourcesResponse listed = ListSources();
-      for (const v1::Source& source : listed.sources()) {
-        if (source.name() == name) found = source;
-      }
-      if (found.state() != v1::SOURCE_STATE_STARTING &&
-          found.state() != v1::SOURCE_STATE_UNSPECIFIED) {
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return found;
-  }
-
-  grpc::Status DetectOn(const std::string& source, v1::DetectResponse* response) {
-    v1::DetectRequest request;
-    request.set_source(source);
-    request.set_box_model("carton_s");
-    grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
-    return stub_->Detect(&context, request, response);
+    StartServerWith(options);
   }
 
   static std::string* recording_;
   static std::string* record_error_;
-  std::unique_ptr<RunningServer> server_;
-  std::unique_ptr<v1::PerceptionService::Stub> stub_;
 };
 
 std::string* OpenNi2ServerTest::recording_ = nullptr;
@@ -146,27 +102,7 @@ TEST_F(OpenNi2ServerTest, DetectOnOpenNi2SourcesFindsBoxesAndFailedOnesAreUnavai
 }
 
 TEST_F(OpenNi2ServerTest, StreamFromARecordingDeliversNewFramesUntilCancelled) {
-  v1::StreamDetectionsRequest request;
-  request.set_source("rec");
-  request.set_box_model("carton_s");
-  grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
-  std::unique_ptr<grpc::ClientReader<v1::DetectResponse>> reader =
-      stub_->StreamDetections(&context, request);
-  uint64_t last_id = 0;
-  for (int i = 0; i < 3; ++i) {
-    v1::DetectResponse response;
-    ASSERT_TRUE(reader->Read(&response)) << "frame " << i;
-    EXPECT_GT(response.frame_id(), last_id);
-    last_id = response.frame_id();
-    EXPECT_EQ(response.source(), "rec");
-    EXPECT_GT(response.boxes_size(), 0);
-  }
-  context.TryCancel();
-  v1::DetectResponse ignored;
-  while (reader->Read(&ignored)) {
-  }
-  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  ExpectStreamInOrderUntilCancelled("rec", 3);
 }
 
 }  // namespace

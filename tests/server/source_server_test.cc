@@ -10,6 +10,7 @@
 
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "server/server.h"
+#include "tests/server/source_server_fixture.h"
 
 namespace cornerpose::server {
 namespace {
@@ -17,56 +18,14 @@ namespace {
 // The repository, so the test finds the bundled frames from any build dir.
 const std::string kCartonFrames = std::string(CORNERPOSE_SOURCE_DIR) + "/data/frames/carton_s";
 
-class SourceServerTest : public ::testing::Test {
+class SourceServerTest : public testing::SourceServerFixture {
  protected:
   void SetUp() override {
     ServerOptions options;
-    options.listen_address = "127.0.0.1:0";
     options.sources = {{.name = "bin", .directory = kCartonFrames, .fps = 5, .loop = true},
                        {.name = "broken", .directory = "/nonexistent/frames"}};
-    absl::StatusOr<std::unique_ptr<RunningServer>> server = StartServer(options);
-    ASSERT_TRUE(server.ok()) << server.status();
-    server_ = *std::move(server);
-    grpc::ChannelArguments args;
-    args.SetMaxReceiveMessageSize(-1);
-    stub_ = v1::PerceptionService::NewStub(grpc::CreateCustomChannel(
-        "127.0.0.1:" + std::to_string(server_->port()), grpc::InsecureChannelCredentials(), args));
+    StartServerWith(options);
   }
-
-  v1::ListSourcesResponse ListSources() {
-    grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
-    v1::ListSourcesResponse response;
-    grpc::Status s = stub_->ListSources(&context, v1::ListSourcesRequest(), &response);
-    EXPECT_TRUE(s.ok()) << s.error_message();
-    return response;
-  }
-
-  grpc::Status DetectOn(const std::string& source, v1::DetectResponse* response) {
-    v1::DetectRequest request;
-    request.set_source(source);
-    request.set_box_model("carton_s");
-    grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
-    return stub_->Detect(&context, request, response);
-  }
-
-  // Polls ListSources until `name` leaves STARTING (or 5 s pass).
-  v1::Source WaitForSource(const std::string& name) {
-    v1::Source found;
-    for (int i = 0; i < 500; ++i) {
-      const v1::ListSourcesResponse listed = ListSources();
-      for (const v1::Source& source : listed.sources()) {
-        if (source.name() == name) found = source;
-      }
-      if (found.state() != v1::SOURCE_STATE_STARTING) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return found;
-  }
-
-  std::unique_ptr<RunningServer> server_;
-  std::unique_ptr<v1::PerceptionService::Stub> stub_;
 };
 
 TEST_F(SourceServerTest, ListsSourcesWithTheirState) {
@@ -118,28 +77,7 @@ TEST_F(SourceServerTest, UnknownSourceIsNotFoundAndFailedSourceUnavailable) {
 }
 
 TEST_F(SourceServerTest, StreamDeliversNewFramesInOrderUntilCancelled) {
-  v1::StreamDetectionsRequest request;
-  request.set_source("bin");
-  request.set_box_model("carton_s");
-  grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
-  std::unique_ptr<grpc::ClientReader<v1::DetectResponse>> reader =
-      stub_->StreamDetections(&context, request);
-
-  uint64_t last_id = 0;
-  for (int i = 0; i < 3; ++i) {
-    v1::DetectResponse response;
-    ASSERT_TRUE(reader->Read(&response)) << "frame " << i;
-    EXPECT_GT(response.frame_id(), last_id);
-    last_id = response.frame_id();
-    EXPECT_EQ(response.source(), "bin");
-    EXPECT_GT(response.boxes_size(), 0);
-  }
-  context.TryCancel();
-  v1::DetectResponse ignored;
-  while (reader->Read(&ignored)) {
-  }
-  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  ExpectStreamInOrderUntilCancelled("bin", 3);
 
   // Still serving after the cancel.
   v1::DetectResponse response;
