@@ -5,6 +5,7 @@
 #include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server_builder.h>
 
+#include <limits>
 #include <mutex>
 #include <set>
 #include <utility>
@@ -42,6 +43,11 @@ absl::StatusOr<std::unique_ptr<RunningServer>> StartServer(const ServerOptions& 
     return absl::InvalidArgumentError(absl::StrCat(
         "max_concurrent_detections ", options.max_concurrent_detections, " must be >= 1"));
   }
+  // At most a day, so the milliseconds fit gRPC's int argument.
+  if (options.max_connection_age_s < 0 || options.max_connection_age_s > 86400) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "max_connection_age_s ", options.max_connection_age_s, " must be in [0, 86400]"));
+  }
 
   std::set<std::string> names;
   for (const SourceSpec& spec : options.sources) {
@@ -75,6 +81,12 @@ absl::StatusOr<std::unique_ptr<RunningServer>> StartServer(const ServerOptions& 
   builder.AddListeningPort(options.listen_address, grpc::InsecureServerCredentials(), &port);
   builder.SetMaxReceiveMessageSize(options.max_message_bytes);
   builder.SetMaxSendMessageSize(options.max_message_bytes);
+  if (options.max_connection_age_s > 0) {
+    builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_MS, options.max_connection_age_s * 1000);
+    // Let open streams finish however long they run.
+    builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_GRACE_MS,
+                               std::numeric_limits<int>::max());
+  }
   builder.RegisterService(service.get());
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   if (server == nullptr || port == 0) {

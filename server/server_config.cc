@@ -43,6 +43,14 @@ absl::StatusOr<ServerOptions> LoadServerConfig(const std::string& path) {
     }
     options.max_concurrent_detections = config.max_concurrent_detections();
   }
+  if (config.has_max_connection_age_s()) {
+    // At most a day in seconds, so the milliseconds fit gRPC's int argument.
+    if (config.max_connection_age_s() < 0 || config.max_connection_age_s() > 86400) {
+      return Invalid(path, absl::StrCat("max_connection_age_s must be in [0, 86400], got ",
+                                        config.max_connection_age_s()));
+    }
+    options.max_connection_age_s = config.max_connection_age_s();
+  }
 
   const std::filesystem::path base = std::filesystem::path(path).parent_path();
   std::set<std::string> names;

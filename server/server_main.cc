@@ -40,6 +40,9 @@ ABSL_FLAG(int, max_message_bytes, cornerpose::server::ServerOptions{}.max_messag
 ABSL_FLAG(int, max_concurrent_detections,
           cornerpose::server::ServerOptions{}.max_concurrent_detections,
           "detections run at once; more wait in a queue");
+ABSL_FLAG(int, max_connection_age_s, cornerpose::server::ServerOptions{}.max_connection_age_s,
+          "ask connections older than this many seconds to reconnect (clients then re-resolve "
+          "the name and reach new replicas; calls in flight are not cut); 0 = never");
 ABSL_FLAG(std::vector<std::string>, source, {},
           "a frame source: NAME=DIR[:FPS[:loop|once]] (recorded frames, default 5 fps, loop), "
           "NAME=openni2:[URI] (an OpenNI2 camera; empty URI = any), or "
@@ -139,6 +142,9 @@ int main(int argc, char** argv) {
   }
   if (given("max_concurrent_detections")) {
     options.max_concurrent_detections = absl::GetFlag(FLAGS_max_concurrent_detections);
+  }
+  if (given("max_connection_age_s")) {
+    options.max_connection_age_s = absl::GetFlag(FLAGS_max_connection_age_s);
   }
   if (!source_flags.empty()) options.sources.clear();
   for (const std::string& text : source_flags) {

@@ -48,6 +48,11 @@ struct ServerOptions {
   // Detections run at once; more wait in a queue. Each uses the detector's
   // worker threads, so this times num_threads should not exceed the cores.
   int max_concurrent_detections = 2;
+  // Connections older than this are asked to reconnect (gRPC GOAWAY), so
+  // clients re-resolve the service name and find new replicas (behind a
+  // headless Kubernetes Service); calls in flight, streams included, run on
+  // undisturbed. Seconds; 0 = never.
+  int max_connection_age_s = 0;
   // The detector options every request starts from (its box is unused: a
   // request names the box).
   DetectorOptions detector;

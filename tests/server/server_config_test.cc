@@ -93,6 +93,7 @@ TEST(ServerConfigTest, ShippedConfigHasTheDocumentedValues) {
   EXPECT_EQ(options->listen_address, "0.0.0.0:50051");
   EXPECT_EQ(options->max_message_bytes, 64 * 1024 * 1024);
   EXPECT_EQ(options->max_concurrent_detections, 2);
+  EXPECT_EQ(options->max_connection_age_s, 300);
   ASSERT_EQ(options->sources.size(), 3u);
   // The demo cell's camera, which deploy/config/robot_client.textproto uses.
   EXPECT_EQ(options->sources[0].name, "cell");
@@ -146,7 +147,8 @@ TEST(ServerConfigTest, BadValuesAreInvalidArgument) {
                                  "sources { name: \"a\" directory: \"x\" fps: 0 }",
                                  "sources { name: \"a\" directory: \"x\" fps: -1 }",
                                  "max_message_bytes: 0", "max_concurrent_detections: -2",
-                                 "box_models { key: \"tiny\" value { l: 0.1 b: 0 h: 0.1 } }"}) {
+                                 "box_models { key: \"tiny\" value { l: 0.1 b: 0 h: 0.1 } }",
+                                 "max_connection_age_s: -1", "max_connection_age_s: 90000"}) {
     const absl::StatusOr<ServerOptions> options =
         LoadServerConfig(WriteConfig("bad.textproto", text));
     EXPECT_EQ(options.status().code(), absl::StatusCode::kInvalidArgument) << text;
@@ -183,6 +185,7 @@ TEST(ServerConfigTest, UnsetFieldsTakeServerOptionsDefaults) {
   EXPECT_EQ(options->listen_address, defaults.listen_address);
   EXPECT_EQ(options->max_message_bytes, defaults.max_message_bytes);
   EXPECT_EQ(options->max_concurrent_detections, defaults.max_concurrent_detections);
+  EXPECT_EQ(options->max_connection_age_s, 0);
   ASSERT_EQ(options->sources.size(), 1u);
   EXPECT_EQ(options->sources[0].fps, SourceSpec{}.fps);
   EXPECT_TRUE(options->sources[0].loop);

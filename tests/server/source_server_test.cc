@@ -114,5 +114,53 @@ TEST_F(SourceServerTest, ShutdownEndsAStreamThatIsStillOpen) {
   EXPECT_FALSE(reader->Finish().ok());
 }
 
+// With a connection-age cap the server asks old connections to reconnect
+// (how clients find new replicas) but never cuts a call in flight: a stream
+// runs on well past the age, and later calls go out on a fresh connection.
+class ConnectionAgeTest : public testing::SourceServerFixture {
+ protected:
+  void SetUp() override {
+    ServerOptions options;
+    options.max_connection_age_s = 1;
+    options.sources = {{.name = "bin", .directory = kCartonFrames, .fps = 10, .loop = true}};
+    StartServerWith(options);
+  }
+};
+
+TEST_F(ConnectionAgeTest, StreamsOutliveTheAgeAndLaterCallsReconnect) {
+  v1::StreamDetectionsRequest request;
+  request.set_source("bin");
+  request.set_box_model("carton_s");
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+  std::unique_ptr<grpc::ClientReader<v1::DetectResponse>> reader =
+      stub_->StreamDetections(&context, request);
+  const auto start = std::chrono::steady_clock::now();
+  int frames = 0;
+  v1::DetectResponse response;
+  // Twice the age, plus the frames: the stream is never cut.
+  while (std::chrono::steady_clock::now() - start < std::chrono::milliseconds(2500)) {
+    ASSERT_TRUE(reader->Read(&response)) << "stream cut after " << frames << " frames";
+    ++frames;
+  }
+  context.TryCancel();
+  while (reader->Read(&response)) {
+  }
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  EXPECT_GT(frames, 3);
+  // Calls after the age still succeed (on a new connection).
+  grpc::Status s = DetectOn("bin", &response);
+  EXPECT_TRUE(s.ok()) << s.error_message();
+}
+
+TEST(ConnectionAgeOptionTest, OutOfRangeIsInvalidArgument) {
+  for (int age : {-1, 86401}) {
+    ServerOptions options;
+    options.listen_address = "127.0.0.1:0";
+    options.max_connection_age_s = age;
+    EXPECT_EQ(StartServer(options).status().code(), absl::StatusCode::kInvalidArgument) << age;
+  }
+}
+
 }  // namespace
 }  // namespace cornerpose::server
