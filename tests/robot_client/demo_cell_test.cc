@@ -21,9 +21,12 @@
 #include "robot_client/ur/kinematics.h"
 #include "robot_client/urscript_program.h"
 #include "tests/robot_client/test_config.h"
+#include "tests/robot_client/test_poses.h"
 
 namespace cornerpose::robot_client {
 namespace {
+
+using testing::ToolDownAt;
 
 // A carton lying flat on the table (base z = 0) at (x, y), yawed, as the
 // camera of `options` sees it.
@@ -88,18 +91,6 @@ TEST(DemoCellTest, CartonUnderTheCameraGoesIntoEverySlot) {
             absl::StatusCode::kResourceExhausted);
 }
 
-// The UR controller emulator's start-up joints (tool pointing down).
-constexpr ur::Joints kEmulatorHome = {0.0, -1.571, 1.571, -1.571, -1.571, 0.0};
-
-Eigen::Isometry3d ToolDown(double x, double y, double z, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() = Eigen::Vector3d(x, y, z);
-  return T;
-}
-
 // The demo's failing retrieve (the emulator stopped it with
 // runtime_error_movel_joint_jump): from the start-up joints a movej to G
 // (0, -0.322, 0.450), tool down with its x along base x, then straight up to
@@ -113,22 +104,22 @@ TEST(DemoCellTest, TheDemosSingularRetrieveIsRejected) {
   StraightMoveOptions straight;
   straight.linear_speed_m_s = options->motion.linear_speed_m_s;
 
-  const Eigen::Isometry3d g = ToolDown(0.0, -0.322, 0.450, 0.0);
+  const Eigen::Isometry3d g = ToolDownAt(0.0, -0.322, 0.450, 0.0);
   absl::StatusOr<ur::Joints> at_g =
-      ur::InverseKinematics(model, g * flange_T_tcp.inverse(), kEmulatorHome);
+      ur::InverseKinematics(model, g * flange_T_tcp.inverse(), testing::kEmulatorHomeJoints);
   ASSERT_TRUE(at_g.ok()) << at_g.status();
   const absl::Status status = CheckStraightMove(
-      model, flange_T_tcp, *at_g, g, ToolDown(0.0, -0.322, 0.680, 0.0), straight, nullptr);
+      model, flange_T_tcp, *at_g, g, ToolDownAt(0.0, -0.322, 0.680, 0.0), straight, nullptr);
   ASSERT_EQ(status.code(), absl::StatusCode::kFailedPrecondition) << status;
   EXPECT_THAT(status.message(),
               ::testing::HasSubstr("passes a singularity at (0.000, -0.322, 0.6"));
 
-  const Eigen::Isometry3d low = ToolDown(0.0, -0.5, 0.15, 0.0);
+  const Eigen::Isometry3d low = ToolDownAt(0.0, -0.5, 0.15, 0.0);
   absl::StatusOr<ur::Joints> at_low =
-      ur::InverseKinematics(model, low * flange_T_tcp.inverse(), kEmulatorHome);
+      ur::InverseKinematics(model, low * flange_T_tcp.inverse(), testing::kEmulatorHomeJoints);
   ASSERT_TRUE(at_low.ok()) << at_low.status();
   ur::Joints end{};
-  EXPECT_TRUE(CheckStraightMove(model, flange_T_tcp, *at_low, low, ToolDown(0.0, -0.5, 0.40, 0.0),
+  EXPECT_TRUE(CheckStraightMove(model, flange_T_tcp, *at_low, low, ToolDownAt(0.0, -0.5, 0.40, 0.0),
                                 straight, &end)
                   .ok());
 }
@@ -148,7 +139,7 @@ TEST(DemoCellTest, PlannedStraightMovesAreClearOfSingularities) {
   straight.linear_speed_m_s = options->motion.linear_speed_m_s;
   const Eigen::Vector3d centre = options->base_T_camera.translation();
   int planned = 0, tried = 0;
-  for (const ur::Joints& start : {kEmulatorHome, *options->clear_joints}) {
+  for (const ur::Joints& start : {testing::kEmulatorHomeJoints, *options->clear_joints}) {
     for (double dx = -0.3; dx <= 0.3001; dx += 0.15) {
       for (double dy = -0.25; dy <= 0.2501; dy += 0.125) {
         for (double top : {0.15, 0.30, 0.45}) {

@@ -15,6 +15,7 @@
 #include "robot_client/straight_move.h"
 #include "robot_client/ur/kinematics.h"
 #include "robot_client/ur/pose.h"
+#include "tests/robot_client/test_poses.h"
 
 namespace cornerpose::robot_client {
 namespace {
@@ -51,7 +52,7 @@ DetectedBox FlatBox(const Eigen::Vector3d& centre, double yaw, double score = 0.
 }
 
 // The UR controller emulator's start-up joints (tool pointing down).
-constexpr ur::Joints kHome = {0.0, -1.571, 1.571, -1.571, -1.571, 0.0};
+constexpr ur::Joints kHome = testing::kEmulatorHomeJoints;
 
 // A UR5e with the suction cup 0.10 m out along the flange's z axis, its
 // joints putting the TCP at `tcp` (the IK solution nearest kHome).

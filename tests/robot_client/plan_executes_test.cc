@@ -20,23 +20,17 @@
 #include "robot_client/ur/pose.h"
 #include "robot_client/urscript_program.h"
 #include "tests/robot_client/test_config.h"
+#include "tests/robot_client/test_poses.h"
 #include "tests/support/ur_emulator/controller.h"
 
 namespace cornerpose::robot_client {
 namespace {
 
+using testing::ToolDownAt;
+
 // Simulated seconds per wall second: a pick takes about 15 simulated s.
 constexpr double kTimeScale = 200.0;
 const absl::Duration kProgramTimeout = absl::Seconds(60);
-
-Eigen::Isometry3d ToolDown(double x, double y, double z, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() = Eigen::Vector3d(x, y, z);
-  return T;
-}
 
 class PlanExecutesTest : public ::testing::Test {
  protected:
@@ -84,9 +78,9 @@ TEST_F(PlanExecutesTest, TheDemosSingularRetrieveFailsOnTheEmulator) {
   const std::string text = absl::StrCat(
       "def singular():\n  set_tcp(",
       ur::FormatPoseLiteral(ur::ToUrPose(options_.gripper.flange_T_tcp)), ")\n  movej(",
-      ur::FormatPoseLiteral(ur::ToUrPose(ToolDown(0.0, -0.322, 0.450, 0.0))),
+      ur::FormatPoseLiteral(ur::ToUrPose(ToolDownAt(0.0, -0.322, 0.450, 0.0))),
       ", a=1.4, v=1.05)\n  movel(",
-      ur::FormatPoseLiteral(ur::ToUrPose(ToolDown(0.0, -0.322, 0.680, 0.0))),
+      ur::FormatPoseLiteral(ur::ToUrPose(ToolDownAt(0.0, -0.322, 0.680, 0.0))),
       ", a=0.5, v=0.1)\nend\n");
   const ur_emulator::ExecutedProgram program = Run(text);
   EXPECT_EQ(program.outcome, ur_emulator::ProgramOutcome::kRuntimeException)

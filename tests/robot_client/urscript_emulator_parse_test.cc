@@ -8,19 +8,13 @@
 
 #include "robot_client/ur/pose.h"
 #include "robot_client/urscript_program.h"
+#include "tests/robot_client/test_poses.h"
 #include "tests/support/ur_emulator/urscript.h"
 
 namespace cornerpose::robot_client {
 namespace {
 
-Eigen::Isometry3d ToolDownAt(double x, double y, double z, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() = Eigen::Vector3d(x, y, z);
-  return T;
-}
+using testing::ToolDownAt;
 
 TEST(UrscriptEmulatorParseTest, EmulatorCompilesTheProgramAsPlanned) {
   for (bool standard : {false, true}) {

@@ -15,20 +15,14 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
 #include "robot_client/ur/pose.h"
+#include "tests/robot_client/test_poses.h"
 
 namespace cornerpose::robot_client {
 namespace {
 
-using ::testing::HasSubstr;
+using testing::ToolDownAt;
 
-Eigen::Isometry3d ToolDownAt(double x, double y, double z, double yaw = 0.0) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() = Eigen::Vector3d(x, y, z);
-  return T;
-}
+using ::testing::HasSubstr;
 
 PickPlan FixedPlan() {
   PickPlan plan;
