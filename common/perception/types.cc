@@ -17,6 +17,10 @@ absl::Status PointCloud::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("cloud is ", width, " x ", height, " but holds ", xyz.size(), " points"));
   }
+  if (!rgb.empty() && rgb.size() != xyz.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cloud has ", xyz.size(), " points but ", rgb.size(), " colours"));
+  }
   return absl::OkStatus();
 }
 

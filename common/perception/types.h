@@ -22,6 +22,10 @@ struct PointCloud {
   int width = 0;
   int height = 0;
   std::vector<Eigen::Vector3f> xyz;
+  // Optional colour (or infrared intensity as grey) registered to the points:
+  // rgb[i] is the colour of xyz[i], packed 0x00RRGGBB. Empty when the frame
+  // has none; the detector then works on depth alone.
+  std::vector<uint32_t> rgb;
 
   bool organized() const { return height > 1; }
   size_t size() const { return xyz.size(); }
@@ -31,8 +35,9 @@ struct PointCloud {
   // inside it (see SanitizeCloud in detector.cc).
   static bool IsValid(const Eigen::Vector3f& p) { return std::isfinite(p.z()); }
 
+  bool has_color() const { return !rgb.empty(); }
   // OK when width * height == xyz.size() and both are positive, or all are
-  // zero (an empty cloud).
+  // zero (an empty cloud), and rgb is empty or as long as xyz.
   absl::Status Validate() const;
 };
 
