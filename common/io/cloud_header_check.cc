@@ -181,6 +181,20 @@ absl::StatusOr<PcdHeader> ParsePcdHeader(absl::string_view head) {
     if (!status.ok()) return status;
   }
   if (!have_data) return absl::InvalidArgumentError("not a PCD file: no DATA line in its header");
+  // PCL reads on past DATA while the lines look like header lines, and obeys
+  // them (found by pcd_fuzzer: a FIELDS line after DATA crashed its reader).
+  while (lines.Next(&line)) {
+    const std::vector<absl::string_view> st = Tokens(line);
+    if (st.empty() || Is(st[0], "#") || Is(st[0], "VERSION") || Is(st[0], "VIEWPOINT")) continue;
+    for (const char* keyword :
+         {"FIELDS", "COLUMNS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "POINTS", "DATA"}) {
+      if (Is(st[0], keyword)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("PCD header line '", line.substr(0, 40), "' after DATA"));
+      }
+    }
+    break;
+  }
   return header;
 }
 

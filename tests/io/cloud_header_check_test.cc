@@ -153,6 +153,20 @@ TEST(CheckPcdBodySizeTest, CompressedBlockSizesMustMatchThePointsAndTheFile) {
               HasSubstr("expands to 120000 bytes"));
 }
 
+// pcd_fuzzer: header lines after DATA, which PCL obeys; a FIELDS line there
+// made PCL's reader fault.
+TEST(ParsePcdHeaderTest, RejectsHeaderLinesAfterData) {
+  EXPECT_THAT(Message(ParsePcdHeader("FIELDS x y z\nPOINTS 1\nDATA ascii\n# c\nFIELDS x\n0 0 0\n")
+                          .status()),
+              HasSubstr("PCD header line 'FIELDS x' after DATA"));
+  EXPECT_TRUE(ParsePcdHeader("FIELDS x y z\nPOINTS 1\nDATA ascii\n0 0 0\nFIELDS\n").ok());
+  const std::string input =
+      std::string(CORNERPOSE_FUZZ_TEST_DATA) + "/pcd_header_lines_after_data.pcd";
+  const absl::Status s = cornerpose::CheckPcdHeader(input);
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(Message(s), HasSubstr("after DATA"));
+}
+
 TEST(CheckPcdHeaderTest, NamesTheFileAndPassesAGoodOne) {
   const std::string dir = ::testing::TempDir();
   const std::string good = dir + "/header_check_good.pcd";
