@@ -181,6 +181,11 @@ absl::StatusOr<PcdHeader> ParsePcdHeader(absl::string_view head) {
     if (!status.ok()) return status;
   }
   if (!have_data) return absl::InvalidArgumentError("not a PCD file: no DATA line in its header");
+  // Without them PCL lays the fields out at offset 0 with no size (found by
+  // pcd_fuzzer: its ascii reader then wrote outside the cloud).
+  if (!have_size || !have_type) {
+    return absl::InvalidArgumentError("PCD header has no SIZE and TYPE lines after its FIELDS");
+  }
   // PCL reads on past DATA while the lines look like header lines, and obeys
   // them (found by pcd_fuzzer: a FIELDS line after DATA crashed its reader).
   while (lines.Next(&line)) {

@@ -44,7 +44,7 @@ TEST(ParsePcdHeaderTest, DataKindsAsPclReadsThem) {
                                    std::pair{"binary_compressed", PcdData::kBinaryCompressed},
                                    std::pair{"anything", PcdData::kAscii}}) {
     const absl::StatusOr<PcdHeader> h =
-        ParsePcdHeader(std::string("FIELDS x y z\nPOINTS 0\nDATA ") + word + "\n");
+        ParsePcdHeader(std::string("FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 0\nDATA ") + word + "\n");
     ASSERT_TRUE(h.ok()) << h.status();
     EXPECT_EQ(h->data, kind) << word;
   }
@@ -153,13 +153,23 @@ TEST(CheckPcdBodySizeTest, CompressedBlockSizesMustMatchThePointsAndTheFile) {
               HasSubstr("expands to 120000 bytes"));
 }
 
+// pcd_fuzzer: FIELDS without SIZE and TYPE lines made PCL's ascii reader
+// write outside the cloud.
+TEST(ParsePcdHeaderTest, RejectsFieldsWithoutSizeAndType) {
+  EXPECT_THAT(Message(ParsePcdHeader("FIELDS x y z\nPOINTS 1\nDATA ascii\n").status()),
+              HasSubstr("no SIZE and TYPE lines"));
+  const absl::Status s = cornerpose::CheckPcdHeader(std::string(CORNERPOSE_FUZZ_TEST_DATA) +
+                                                    "/pcd_fields_without_size_and_type.pcd");
+  EXPECT_THAT(Message(s), HasSubstr("no SIZE and TYPE lines"));
+}
+
 // pcd_fuzzer: header lines after DATA, which PCL obeys; a FIELDS line there
 // made PCL's reader fault.
 TEST(ParsePcdHeaderTest, RejectsHeaderLinesAfterData) {
-  EXPECT_THAT(Message(ParsePcdHeader("FIELDS x y z\nPOINTS 1\nDATA ascii\n# c\nFIELDS x\n0 0 0\n")
+  EXPECT_THAT(Message(ParsePcdHeader("FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n# c\nFIELDS x\n0 0 0\n")
                           .status()),
               HasSubstr("PCD header line 'FIELDS x' after DATA"));
-  EXPECT_TRUE(ParsePcdHeader("FIELDS x y z\nPOINTS 1\nDATA ascii\n0 0 0\nFIELDS\n").ok());
+  EXPECT_TRUE(ParsePcdHeader("FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n0 0 0\nFIELDS\n").ok());
   const std::string input =
       std::string(CORNERPOSE_FUZZ_TEST_DATA) + "/pcd_header_lines_after_data.pcd";
   const absl::Status s = cornerpose::CheckPcdHeader(input);
