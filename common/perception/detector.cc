@@ -22,12 +22,16 @@ double MsSince(Clock::time_point t0) {
 
 // Points with a NaN, an infinity or a coordinate beyond any depth camera's
 // range in any axis become NaN points (no return), so one bad value cannot
-// poison the intrinsics fit or a neighbourhood. Copies only when needed.
+// poison the intrinsics fit or a neighbourhood; in a camera frame (organized)
+// so do depths nearer than any depth camera measures (the pixel radius
+// r fx / z grows without bound as z -> 0). Copies only when needed.
 const PointCloud& SanitizeCloud(const PointCloud& cloud, PointCloud* storage) {
   constexpr float kMaxCoordinate = 100.0f;  // metres
-  auto bad = [](const Eigen::Vector3f& p) {
+  constexpr float kMinCameraDepthM = 0.01f;  // depth cameras' minimum range is centimetres
+  const float min_depth = cloud.organized() ? kMinCameraDepthM : -kMaxCoordinate;
+  auto bad = [min_depth](const Eigen::Vector3f& p) {
     return !(std::abs(p.x()) <= kMaxCoordinate && std::abs(p.y()) <= kMaxCoordinate &&
-             std::abs(p.z()) <= kMaxCoordinate) &&
+             p.z() >= min_depth && p.z() <= kMaxCoordinate) &&
            !(std::isnan(p.x()) && std::isnan(p.y()) && std::isnan(p.z()));
   };
   if (std::none_of(cloud.xyz.begin(), cloud.xyz.end(), bad)) return cloud;
@@ -94,6 +98,10 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
       det.timings.total_ms = MsSince(t_start);
       return det;
     }
+    if (absl::Status s = k->Validate(); !s.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("the organized cloud's points imply implausible ", s.message()));
+    }
     camera = *k;
   }
   // A single-view unorganized cloud is laid back onto the camera's pixel
@@ -104,6 +112,8 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   bool project = !cloud.organized() && options.project_unorganized;
   if (project) {
     projected = OrganizeByProjection(cloud, camera);
+    PointCloud in_range;  // the projected frame gets a camera's depth range
+    if (&SanitizeCloud(projected, &in_range) != &projected) projected = std::move(in_range);
     const auto valid = [](const std::vector<Eigen::Vector3f>& xyz) {
       return std::count_if(xyz.begin(), xyz.end(), PointCloud::IsValid);
     };
