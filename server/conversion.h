@@ -9,7 +9,7 @@
 #include "common/perception/types.h"
 #include "cornerpose/v1/geometry.pb.h"
 #include "cornerpose/v1/perception_service.pb.h"
-#include "server/frame_source.h"
+#include "server/sources/frame_source.h"
 
 namespace cornerpose::server {
 

@@ -1,4 +1,4 @@
-#include "server/detect_request.h"
+#include "server/service/detect_request.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

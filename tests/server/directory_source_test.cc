@@ -1,6 +1,6 @@
 // DirectorySource over temporary directories of PCDs and depth PNGs, and the
 // --source flag syntax. Short timeouts everywhere: a bug must fail, not hang.
-#include "server/directory_source.h"
+#include "server/sources/directory_source.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common/io/cloud_io.h"
-#include "server/source_spec.h"
+#include "server/sources/source_spec.h"
 
 namespace cornerpose::server {
 namespace {
