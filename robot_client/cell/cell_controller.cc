@@ -5,6 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "robot_client/cell/cell_steps.h"
 #include "robot_client/planning/grasp_geometry.h"
 #include "robot_client/planning/pick_selection.h"
 #include "robot_client/planning/place_pattern.h"
@@ -28,17 +29,6 @@ PickOutcome OutcomeOf(ur::ProgramOutcome::Kind kind) {
       return PickOutcome::kTimeout;
   }
   return PickOutcome::kTimeout;
-}
-
-// "3 boxes, none pickable: #0 grasp face tilted ...; #1 ..."
-std::string DescribeRejections(const PickSelection& selection) {
-  if (selection.verdicts.empty()) return "no boxes detected";
-  std::vector<std::string> reasons;
-  for (const BoxVerdict& v : selection.verdicts) {
-    reasons.push_back(absl::StrCat("#", v.index, " ", v.reason));
-  }
-  return absl::StrCat(selection.verdicts.size(),
-                      " boxes, none pickable: ", absl::StrJoin(reasons, "; "));
 }
 
 }  // namespace
@@ -170,16 +160,22 @@ bool CellController::RobotReady() {
 
 bool CellController::Step() {
   const CellStatusSnapshot now = Status();
-  if (now.next_slot >= now.num_slots) {
-    SetState(CellState::kFinished, "the place pattern is full");
-    return false;
-  }
-  if (options_.max_picks > 0 && now.picks_done >= options_.max_picks) {
-    SetState(CellState::kFinished, absl::StrCat("made max_picks (", options_.max_picks, ")"));
+  if (std::optional<std::string> finished = FinishedReason(now, options_.max_picks)) {
+    SetState(CellState::kFinished, *finished);
     return false;
   }
   if (!RobotReady()) return true;
+  std::optional<FrameDetection> frame = AwaitFreshFrame();
+  if (!frame) return true;
+  std::optional<ur::Joints> joints = CurrentJoints();
+  if (!joints) return true;
+  std::optional<PreparedPick> pick = PreparePick(*frame, *joints, now.next_slot);
+  if (!pick) return true;
+  RunPick(*std::move(pick));
+  return true;
+}
 
+std::optional<FrameDetection> CellController::AwaitFreshFrame() {
   std::optional<FrameDetection> frame =
       perception_->WaitForFrameAfter(not_before_, controller_.frame_wait);
   if (!frame) {
@@ -191,81 +187,79 @@ bool CellController::Step() {
         SetState(CellState::kStopped, absl::StrCat("perception stream lost: ", error));
       }
     }
-    return true;
+    return std::nullopt;
   }
   SetState(CellState::kIdle);
   // Judge each frame once.
   not_before_ = std::max(not_before_, frame->capture_time);
+  return frame;
+}
 
-  ur::Joints joints = *options_.clear_joints;  // dry run: the arm is assumed at the clear pose
-  if (!options_.dry_run) {
-    absl::StatusOr<ur::RtdeState> state = link_.State();
-    if (!state.ok()) return true;
-    joints = state->actual_q;
-  }
+std::optional<ur::Joints> CellController::CurrentJoints() {
+  // Dry run: the arm is assumed at the clear pose.
+  if (options_.dry_run) return *options_.clear_joints;
+  absl::StatusOr<ur::RtdeState> state = link_.State();
+  if (!state.ok()) return std::nullopt;
+  return state->actual_q;
+}
+
+std::optional<CellController::PreparedPick> CellController::PreparePick(const FrameDetection& frame,
+                                                                        const ur::Joints& joints,
+                                                                        int slot) {
   const absl::Time plan_start = absl::Now();
+  // The size the server detected with: it alone resolves model names.
+  const BoxDims dims = frame.box_dims.value_or(options_.perception.box);
   const PickSelection selection =
-      SelectPick(frame->detection.boxes, options_.base_T_camera, options_.perception.box,
-                 options_.selection, options_.workspace, options_.waypoints, reachable_);
-  const std::string frame_name = absl::StrCat(frame->source, "#", frame->frame_id);
+      SelectPick(frame.boxes, options_.base_T_camera, dims, options_.selection, options_.workspace,
+                 options_.waypoints, reachable_);
+  const std::string frame_name = absl::StrCat(frame.source, "#", frame.frame_id);
   if (!selection.chosen) {
-    if (callbacks_.on_note) {
-      callbacks_.on_note(absl::StrCat(frame_name, ": ", DescribeRejections(selection)));
-    }
-    return true;
+    Note(absl::StrCat(frame_name, ": ", DescribeRejections(selection)));
+    return std::nullopt;
   }
-  // The best box first; when its waypoints cannot all be reached (a
-  // straight move through a singularity, say), the next one.
-  const BoxVerdict* chosen = nullptr;
-  absl::StatusOr<PickPlan> plan = absl::NotFoundError("no box");
-  std::vector<std::string> refusals;
-  for (int index : selection.ranked) {
-    const BoxVerdict& candidate = selection.verdicts[static_cast<size_t>(index)];
-    plan = PlanPickForSlot(options_, joints, candidate.box, now.next_slot);
-    if (plan.ok()) {
-      chosen = &candidate;
-      break;
-    }
-    refusals.push_back(absl::StrCat("#", index, " ", plan.status().message()));
+  PlannedPick planned = PlanFirstPlannable(selection, [&](const BoxInBase& box) {
+    return PlanPickForSlot(options_, joints, box, slot, dims);
+  });
+  if (planned.chosen == nullptr) {
+    Note(
+        absl::StrCat(frame_name, ": cannot plan any box: ", absl::StrJoin(planned.refusals, "; ")));
+    return std::nullopt;
   }
-  if (chosen == nullptr) {
-    if (callbacks_.on_note) {
-      callbacks_.on_note(
-          absl::StrCat(frame_name, ": cannot plan any box: ", absl::StrJoin(refusals, "; ")));
-    }
-    return true;
-  }
-  PickRecord record;
+  PreparedPick pick;
+  PickRecord& record = pick.record;
   record.pick_id = next_pick_id_;
   record.program_name = PickProgramName(static_cast<int>(next_pick_id_));
-  record.source = frame->source;
-  record.frame_id = frame->frame_id;
-  record.capture_time = frame->capture_time;
-  record.score = chosen->score;
-  record.plan = *plan;
-  absl::StatusOr<std::string> program = RenderPickProgram(
-      record.program_name, *plan, options_.gripper, options_.motion, *options_.clear_joints);
+  record.source = frame.source;
+  record.frame_id = frame.frame_id;
+  record.capture_time = frame.capture_time;
+  record.score = planned.chosen->score;
+  record.plan = *planned.plan;
+  absl::StatusOr<std::string> program =
+      RenderPickProgram(record.program_name, *planned.plan, options_.gripper, options_.motion,
+                        *options_.clear_joints);
   record.plan_ms = absl::ToDoubleMilliseconds(absl::Now() - plan_start);
   if (!program.ok()) {
-    if (callbacks_.on_note) {
-      callbacks_.on_note(
-          absl::StrCat(frame_name, ": cannot render the program: ", program.status().message()));
-    }
-    return true;
+    Note(absl::StrCat(frame_name, ": cannot render the program: ", program.status().message()));
+    return std::nullopt;
   }
   ++next_pick_id_;
-  if (callbacks_.on_program) callbacks_.on_program(record.program_name, *program);
+  pick.program = *std::move(program);
+  if (callbacks_.on_program) callbacks_.on_program(record.program_name, pick.program);
+  return pick;
+}
 
+void CellController::RunPick(PreparedPick pick) {
+  PickRecord& record = pick.record;
   record.start_time = absl::Now();
   if (options_.dry_run) {
     record.outcome = PickOutcome::kDryRun;
     not_before_ = absl::Now();
     Record(std::move(record));
-    return true;
+    return;
   }
   SetState(CellState::kPicking);
   const ur::ProgramOutcome outcome =
-      link_.RunProgram(record.program_name, *program, controller_.program_timeout);
+      link_.RunProgram(record.program_name, pick.program, controller_.program_timeout);
   // Every frame captured until now may show the arm or the old scene.
   not_before_ = absl::Now();
   record.program_s = absl::ToDoubleSeconds(not_before_ - record.start_time);
@@ -279,7 +273,10 @@ bool CellController::Step() {
   }
   Record(std::move(record));
   SetState(CellState::kIdle);
-  return true;
+}
+
+void CellController::Note(const std::string& message) {
+  if (callbacks_.on_note) callbacks_.on_note(message);
 }
 
 }  // namespace cornerpose::robot_client

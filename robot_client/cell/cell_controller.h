@@ -65,8 +65,27 @@ class CellController {
   std::vector<PickRecord> Picks(size_t max = 0) const;
 
  private:
-  // One pass of the loop; false when the cell is finished.
+  // A planned, rendered pick, ready to run.
+  struct PreparedPick {
+    PickRecord record;
+    std::string program;
+  };
+
+  // One pass of the loop, in the phases below; false when the cell is
+  // finished.
   bool Step();
+  // The newest frame captured after the last move (each judged once), or
+  // nullopt (with the state saying why when the stream is down).
+  std::optional<FrameDetection> AwaitFreshFrame();
+  // Where the arm is (dry run: the clear pose); nullopt without a state.
+  std::optional<ur::Joints> CurrentJoints();
+  // Selection, planning (the best box that plans) and the program of one
+  // frame; nullopt, with a note saying why, when the frame gives no pick.
+  std::optional<PreparedPick> PreparePick(const FrameDetection& frame, const ur::Joints& joints,
+                                          int slot);
+  // Runs the program (dry run: records it) and records the outcome.
+  void RunPick(PreparedPick pick);
+  void Note(const std::string& message);
   // Whether the robot can take a program now; sets STOPPED and waits when not.
   bool RobotReady();
   // Whether the gripper's suction output is on in `state`.

@@ -6,8 +6,8 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/wire/box_wire.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
-#include "tools/client/response_conversion.h"
 
 namespace cornerpose::robot_client {
 
@@ -79,9 +79,7 @@ void PerceptionSubscriber::Run() {
   v1::StreamDetectionsRequest request;
   request.set_source(options_.source);
   if (options_.box) {
-    request.mutable_box()->set_l(options_.box->l);
-    request.mutable_box()->set_b(options_.box->b);
-    request.mutable_box()->set_h(options_.box->h);
+    *request.mutable_box() = wire::ToProto(*options_.box);
   } else {
     request.set_box_model(options_.box_model);
   }
@@ -100,18 +98,21 @@ void PerceptionSubscriber::Run() {
         stub->StreamDetections(&context, request);
     v1::DetectResponse response;
     while (reader->Read(&response)) {
-      absl::StatusOr<Detection> detection = tools::DetectionFromProto(response);
+      absl::StatusOr<std::vector<DetectedBox>> boxes = wire::BoxesFromProto(response);
       std::lock_guard<std::mutex> lock(mutex_);
-      if (!detection.ok()) {
-        last_error_ = absl::StrCat("bad detection from ", options_.server, ": ",
-                                   detection.status().message());
+      if (!boxes.ok()) {
+        last_error_ =
+            absl::StrCat("bad detection from ", options_.server, ": ", boxes.status().message());
         continue;
       }
-      latest_ =
-          FrameDetection{.detection = *std::move(detection),
-                         .source = response.source(),
-                         .frame_id = response.frame_id(),
-                         .capture_time = absl::FromUnixNanos(response.capture_time_unix_nanos())};
+      latest_ = FrameDetection{
+          .boxes = *std::move(boxes),
+          .box_dims = response.has_box_dims_used()
+                          ? std::optional<BoxDims>(wire::BoxDimsFromProto(response.box_dims_used()))
+                          : std::nullopt,
+          .source = response.source(),
+          .frame_id = response.frame_id(),
+          .capture_time = absl::FromUnixNanos(response.capture_time_unix_nanos())};
       connected_ = true;
       ++frames_received_;
       backoff = options_.initial_backoff;

@@ -13,9 +13,10 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "absl/time/time.h"
-#include "common/perception/types.h"
+#include "common/box/box_types.h"
 
 namespace grpc {
 class ClientContext;
@@ -38,9 +39,13 @@ struct PerceptionSubscriberOptions {
   absl::Duration max_backoff = absl::Seconds(5);
 };
 
-// One frame's detection and where it came from.
+// One frame's detected boxes and where they came from.
 struct FrameDetection {
-  Detection detection;
+  // Best score first.
+  std::vector<DetectedBox> boxes;
+  // The size the server detected with (it resolves model names); unset
+  // from a server that does not say.
+  std::optional<BoxDims> box_dims;
   std::string source;
   uint64_t frame_id = 0;
   absl::Time capture_time;

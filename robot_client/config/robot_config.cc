@@ -5,8 +5,10 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "common/box/box_models.h"
 #include "common/config/text_proto_file.h"
-#include "common/perception/box_models.h"
+#include "common/validation/range_check.h"
+#include "common/wire/geometry_wire.h"
 #include "cornerpose/v1/robot_client_config.pb.h"
 
 namespace cornerpose::robot_client {
@@ -16,22 +18,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 absl::Status Invalid(absl::string_view message) { return absl::InvalidArgumentError(message); }
 
-// OK when lo <= v <= hi (and v is finite).
-absl::Status CheckRange(absl::string_view field, double v, double lo, double hi) {
-  if (std::isfinite(v) && v >= lo && v <= hi) return absl::OkStatus();
-  return Invalid(absl::StrCat(field, " must be in [", lo, ", ", hi, "], got ", v));
-}
-
-// OK when 0 < v <= hi.
-absl::Status CheckPositive(absl::string_view field, double v, double hi = 1e6) {
-  if (std::isfinite(v) && v > 0.0 && v <= hi) return absl::OkStatus();
-  return Invalid(absl::StrCat(field, " must be > 0", hi < 1e6 ? absl::StrCat(" and <= ", hi) : "",
-                              ", got ", v));
-}
-
 absl::Status CheckPort(absl::string_view field, int port) {
-  if (port >= 1 && port <= 65535) return absl::OkStatus();
-  return Invalid(absl::StrCat(field, " must be in [1, 65535], got ", port));
+  return CheckRange(field, port, 1, 65535);
 }
 
 absl::Status CheckRigid(absl::string_view field, const Eigen::Isometry3d& T) {
@@ -48,26 +36,8 @@ std::string Xyz(const Eigen::Vector3d& p) {
   return absl::StrFormat("(%.4f, %.4f, %.4f)", p.x(), p.y(), p.z());
 }
 
-Eigen::Vector3d ToEigen(const v1::Vector3& v) { return {v.x(), v.y(), v.z()}; }
-
-// A pose with a unit quaternion (within 1e-3; normalised). An unset
-// orientation (all zero) is an error like any other non-unit one.
-absl::StatusOr<Eigen::Isometry3d> ToIsometry(absl::string_view field, const v1::Pose& pose) {
-  const v1::Quaternion& q = pose.orientation();
-  Eigen::Quaterniond quaternion(q.w(), q.x(), q.y(), q.z());
-  const double norm = quaternion.norm();
-  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) {
-    return Invalid(absl::StrCat(field,
-                                ".orientation must be a unit quaternion (w x y z), got norm ", norm,
-                                " for (", q.w(), ", ", q.x(), ", ", q.y(), ", ", q.z(), ")"));
-  }
-  const Eigen::Vector3d position = ToEigen(pose.position());
-  if (!position.allFinite()) return Invalid(absl::StrCat(field, ".position is not finite"));
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = quaternion.normalized().toRotationMatrix();
-  T.translation() = position;
-  return T;
-}
+using wire::PoseFromProto;
+using wire::Vector3dFromProto;
 
 absl::StatusOr<RobotClientOptions> FromProto(const v1::RobotClientConfig& config) {
   RobotClientOptions options;
@@ -116,14 +86,14 @@ absl::StatusOr<RobotClientOptions> FromProto(const v1::RobotClientConfig& config
   // base_pose_camera
   if (!config.has_base_pose_camera()) return Invalid("base_pose_camera is required");
   absl::StatusOr<Eigen::Isometry3d> base_T_camera =
-      ToIsometry("base_pose_camera", config.base_pose_camera());
+      PoseFromProto(config.base_pose_camera(), "base_pose_camera");
   if (!base_T_camera.ok()) return base_T_camera.status();
   options.base_T_camera = *base_T_camera;
 
   // workspace
   if (!config.has_workspace()) return Invalid("workspace is required");
-  options.workspace.min_m = ToEigen(config.workspace().min());
-  options.workspace.max_m = ToEigen(config.workspace().max());
+  options.workspace.min_m = Vector3dFromProto(config.workspace().min());
+  options.workspace.max_m = Vector3dFromProto(config.workspace().max());
 
   // selection
   const v1::SelectionConfig& selection = config.selection();
@@ -137,8 +107,8 @@ absl::StatusOr<RobotClientOptions> FromProto(const v1::RobotClientConfig& config
   const v1::GripperConfig& gripper = config.gripper();
   GripperOptions& g = options.gripper;
   if (gripper.has_tcp_offset()) {
-    const Eigen::Vector3d position = ToEigen(gripper.tcp_offset().position());
-    const Eigen::Vector3d rotation = ToEigen(gripper.tcp_offset().rotation_vector());
+    const Eigen::Vector3d position = Vector3dFromProto(gripper.tcp_offset().position());
+    const Eigen::Vector3d rotation = Vector3dFromProto(gripper.tcp_offset().rotation_vector());
     if (!position.allFinite() || !rotation.allFinite()) {
       return Invalid("gripper.tcp_offset is not finite");
     }
@@ -180,7 +150,8 @@ absl::StatusOr<RobotClientOptions> FromProto(const v1::RobotClientConfig& config
   const v1::PlacePatternConfig& pattern = config.place_pattern();
   PlacePatternOptions& pp = options.place_pattern;
   if (!pattern.has_origin()) return Invalid("place_pattern.origin is required");
-  absl::StatusOr<Eigen::Isometry3d> origin = ToIsometry("place_pattern.origin", pattern.origin());
+  absl::StatusOr<Eigen::Isometry3d> origin =
+      PoseFromProto(pattern.origin(), "place_pattern.origin");
   if (!origin.ok()) return origin.status();
   pp.base_T_origin = *origin;
   auto count = [](uint32_t v) { return static_cast<int>(std::min<uint32_t>(v, 1000000)); };
@@ -254,12 +225,12 @@ absl::Status GripperOptions::Validate() const {
     return Invalid(absl::StrCat("gripper.tcp_offset is ", flange_T_tcp.translation().norm(),
                                 " m from the flange; at most 1 m"));
   }
+  // Tool outputs 0..1, standard outputs 0..7.
   const int max_index = suction_output == SuctionOutputKind::kTool ? 1 : 7;
-  if (suction_output_index < 0 || suction_output_index > max_index) {
-    return Invalid(
-        absl::StrCat("gripper.suction_output_index must be in [0, ", max_index, "] for ",
-                     suction_output == SuctionOutputKind::kTool ? "the tool" : "standard",
-                     " outputs, got ", suction_output_index));
+  if (absl::Status s =
+          CheckRange("gripper.suction_output_index", suction_output_index, 0, max_index);
+      !s.ok()) {
+    return s;
   }
   if (absl::Status s = CheckRange("gripper.grasp_settle_s", grasp_settle_s, 0.0, 60.0); !s.ok()) {
     return s;
@@ -331,11 +302,11 @@ absl::Status RobotClientOptions::Validate() const {
       !s.ok()) {
     return s;
   }
-  if (!(perception.reconnect_max_s >= perception.reconnect_initial_s) ||
-      !(perception.reconnect_max_s <= 3600.0)) {
-    return Invalid(absl::StrCat("perception.reconnect_max_s must be in [reconnect_initial_s ",
-                                perception.reconnect_initial_s, ", 3600], got ",
-                                perception.reconnect_max_s));
+  // At least the first wait (reconnect_initial_s).
+  if (absl::Status s = CheckRange("perception.reconnect_max_s", perception.reconnect_max_s,
+                                  perception.reconnect_initial_s, 3600.0);
+      !s.ok()) {
+    return s;
   }
   // robot
   if (robot.host.empty()) return Invalid("robot.host is required");
@@ -372,7 +343,7 @@ absl::Status RobotClientOptions::Validate() const {
                                 Xyz(workspace.max_m)));
   }
   if (status_listen_address.empty()) return Invalid("status_listen_address is empty");
-  if (max_picks < 0) return Invalid(absl::StrCat("max_picks must be >= 0, got ", max_picks));
+  if (absl::Status s = CheckAtLeast("max_picks", max_picks, 0.0); !s.ok()) return s;
   return absl::OkStatus();
 }
 

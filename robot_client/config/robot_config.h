@@ -16,7 +16,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "common/perception/types.h"
+#include "common/box/box_types.h"
 #include "robot_client/ur/kinematics.h"
 #include "robot_client/ur/pose.h"
 

@@ -11,7 +11,7 @@
 #include <array>
 #include <functional>
 
-#include "common/perception/types.h"
+#include "common/box/box_types.h"
 #include "robot_client/ur/kinematics.h"
 #include "robot_client/ur/pose.h"
 

@@ -198,6 +198,12 @@ absl::StatusOr<PickPlan> PlanPick(const PickArm& arm, const BoxInBase& box, cons
 absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
                                          const ur::Joints& current_joints, const BoxInBase& box,
                                          int slot) {
+  return PlanPickForSlot(options, current_joints, box, slot, options.perception.box);
+}
+
+absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
+                                         const ur::Joints& current_joints, const BoxInBase& box,
+                                         int slot, const BoxDims& dims) {
   absl::StatusOr<Eigen::Isometry3d> base_T_slot = SlotPose(options.place_pattern, slot);
   if (!base_T_slot.ok()) return base_T_slot.status();
   PickArm arm;
@@ -205,8 +211,7 @@ absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
   arm.flange_T_tcp = options.gripper.flange_T_tcp;
   arm.joints = current_joints;
   arm.straight_moves.linear_speed_m_s = options.motion.linear_speed_m_s;
-  return PlanPick(arm, box, options.perception.box, *base_T_slot, slot, options.waypoints,
-                  options.workspace);
+  return PlanPick(arm, box, dims, *base_T_slot, slot, options.waypoints, options.workspace);
 }
 
 }  // namespace cornerpose::robot_client

@@ -24,7 +24,7 @@
 #include <Eigen/Geometry>
 
 #include "absl/status/statusor.h"
-#include "common/perception/types.h"
+#include "common/box/box_types.h"
 #include "robot_client/config/robot_config.h"
 #include "robot_client/planning/grasp_geometry.h"
 #include "robot_client/planning/straight_move.h"
@@ -95,7 +95,11 @@ absl::StatusOr<PickPlan> PlanPick(const PickArm& arm, const BoxInBase& box, cons
 // The daemon's entry point: PlanPick with the configured arm model, the
 // gripper's TCP offset, `current_joints`, the motion's linear speed and the
 // slot pose from the place pattern (RESOURCE_EXHAUSTED when `slot` is past
-// its end).
+// its end), for a box of `dims` (the size the server detected with).
+absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
+                                         const ur::Joints& current_joints, const BoxInBase& box,
+                                         int slot, const BoxDims& dims);
+// The same for the configured box size, options.perception.box.
 absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
                                          const ur::Joints& current_joints, const BoxInBase& box,
                                          int slot);

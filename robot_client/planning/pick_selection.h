@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "common/perception/types.h"
+#include "common/box/box_types.h"
 #include "robot_client/config/robot_config.h"
 #include "robot_client/planning/grasp_geometry.h"
 

@@ -9,8 +9,10 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "common/config/text_proto_file.h"
+#include "common/validation/range_check.h"
+#include "common/wire/box_wire.h"
+#include "common/wire/detector_wire.h"
 #include "cornerpose/v1/server_config.pb.h"
-#include "server/service/detect_request.h"
 
 namespace cornerpose::server {
 namespace {
@@ -28,26 +30,28 @@ absl::StatusOr<ServerOptions> LoadServerConfig(const std::string& path) {
   ServerOptions options;
   if (!config.listen_address().empty()) options.listen_address = config.listen_address();
   if (config.has_max_message_bytes()) {
-    if (config.max_message_bytes() <= 0 ||
-        config.max_message_bytes() > std::numeric_limits<int>::max()) {
-      return Invalid(
-          path, absl::StrCat("max_message_bytes must be in [1, ", std::numeric_limits<int>::max(),
-                             "], got ", config.max_message_bytes()));
+    if (absl::Status s = CheckRange("max_message_bytes", int64_t{config.max_message_bytes()}, 1,
+                                    std::numeric_limits<int>::max());
+        !s.ok()) {
+      return Invalid(path, std::string(s.message()));
     }
     options.max_message_bytes = static_cast<int>(config.max_message_bytes());
   }
   if (config.has_max_concurrent_detections()) {
-    if (config.max_concurrent_detections() <= 0) {
-      return Invalid(path, absl::StrCat("max_concurrent_detections must be > 0, got ",
-                                        config.max_concurrent_detections()));
+    if (absl::Status s =
+            CheckRange("max_concurrent_detections", int64_t{config.max_concurrent_detections()}, 1,
+                       std::numeric_limits<int>::max());
+        !s.ok()) {
+      return Invalid(path, std::string(s.message()));
     }
     options.max_concurrent_detections = config.max_concurrent_detections();
   }
   if (config.has_max_connection_age_s()) {
     // At most a day in seconds, so the milliseconds fit gRPC's int argument.
-    if (config.max_connection_age_s() < 0 || config.max_connection_age_s() > 86400) {
-      return Invalid(path, absl::StrCat("max_connection_age_s must be in [0, 86400], got ",
-                                        config.max_connection_age_s()));
+    if (absl::Status s =
+            CheckRange("max_connection_age_s", config.max_connection_age_s(), 0, 86400);
+        !s.ok()) {
+      return Invalid(path, std::string(s.message()));
     }
     options.max_connection_age_s = config.max_connection_age_s();
   }
@@ -87,33 +91,29 @@ absl::StatusOr<ServerOptions> LoadServerConfig(const std::string& path) {
       case v1::SourceConfig::KIND_NOT_SET:
         return Invalid(path, label + ": set one of directory, device_uri or oni_file");
     }
-    if (source.has_fps() && !(source.fps() > 0 && std::isfinite(source.fps()))) {
-      return Invalid(
-          path, absl::StrCat(where, " (", source.name(), "): fps must be > 0, got ", source.fps()));
+    if (source.has_fps()) {
+      if (absl::Status s = CheckPositive(absl::StrCat(label, ": fps"), source.fps()); !s.ok()) {
+        return Invalid(path, std::string(s.message()));
+      }
     }
     if (source.has_fps()) spec.fps = source.fps();
     if (source.has_loop()) spec.loop = source.loop();
     if (source.has_playback_speed()) {
-      if (!(source.playback_speed() > 0 && std::isfinite(source.playback_speed()))) {
-        return Invalid(path, absl::StrCat(label, ": playback_speed must be > 0, got ",
-                                          source.playback_speed()));
+      if (absl::Status s =
+              CheckPositive(absl::StrCat(label, ": playback_speed"), source.playback_speed());
+          !s.ok()) {
+        return Invalid(path, std::string(s.message()));
       }
       spec.playback_speed = source.playback_speed();
     }
     options.sources.push_back(std::move(spec));
   }
 
-  for (const auto& [name, box] : config.box_models()) {
-    if (name.empty()) return Invalid(path, "box_models: empty model name");
-    if (!(box.l() > 0) || !(box.b() > 0) || !(box.h() > 0) || !std::isfinite(box.l()) ||
-        !std::isfinite(box.b()) || !std::isfinite(box.h())) {
-      return Invalid(path,
-                     absl::StrCat("box_models[\"", name, "\"]: l, b and h must be > 0 metres"));
-    }
-    options.box_models[name] = BoxDims{box.l(), box.b(), box.h()};
-  }
+  absl::StatusOr<BoxModels> box_models = wire::BoxModelsFromProto(config.box_models());
+  if (!box_models.ok()) return Invalid(path, std::string(box_models.status().message()));
+  options.box_models = *std::move(box_models);
 
-  ApplyDetectorOverrides(config.detector_defaults(), &options.detector);
+  wire::ApplyDetectorOverrides(config.detector_defaults(), &options.detector);
   // Validated with a stand-in box: requests bring their own.
   DetectorOptions check = options.detector;
   check.box = {0.3, 0.2, 0.15};

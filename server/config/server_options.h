@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "common/box/box_models.h"
 #include "common/perception/detector.h"
 
 namespace cornerpose::server {
@@ -58,7 +59,7 @@ struct ServerOptions {
   DetectorOptions detector;
   // Box sizes requests can name as box_model, besides the built-in models
   // (a name here takes precedence).
-  std::map<std::string, BoxDims> box_models;
+  BoxModels box_models;
   // Frame sources requests can name. A source that fails (a missing
   // directory, say) is listed as FAILED; the server still starts.
   std::vector<SourceSpec> sources;

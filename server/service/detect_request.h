@@ -1,25 +1,23 @@
-// Turns a DetectRequest into what the detector takes: the cloud and the
-// options. Every refusal is INVALID_ARGUMENT (or NOT_FOUND for a source)
-// with a message that names the field.
+// Turns a DetectRequest (or a StreamDetectionsRequest) into what the
+// detector takes: the cloud and the options. The messages themselves convert
+// in the wire library (common/wire); here is what the service decides: which
+// input, which box (the server alone resolves model names), which camera.
+// Every refusal is INVALID_ARGUMENT (or NOT_FOUND for a source) with a
+// message that names the field.
 #pragma once
 
-#include <map>
-#include <string>
-
 #include "absl/status/statusor.h"
+#include "common/box/box_models.h"
 #include "common/perception/detector.h"
 #include "common/perception/types.h"
 #include "cornerpose/v1/perception_service.pb.h"
 
 namespace cornerpose::server {
 
-// The cloud from `cloud` or `depth_image`. A `source` is resolved by the
-// service, which owns the sources; here it is NOT_FOUND. No input at all is
-// INVALID_ARGUMENT.
+// The cloud from `cloud` or `depth_image`, with the colour of `color` (or of
+// cloud.rgb) when given. A `source` is resolved by the service, which owns
+// the sources; here it is NOT_FOUND. No input at all is INVALID_ARGUMENT.
 absl::StatusOr<PointCloud> CloudFromRequest(const v1::DetectRequest& request);
-
-// Box sizes by model name (the server configuration's box_models).
-using BoxModels = std::map<std::string, BoxDims>;
 
 // The server's defaults with the request's box size and overrides applied,
 // validated. The box comes from `box` (every side > 0) or `box_model`: a
@@ -27,10 +25,9 @@ using BoxModels = std::map<std::string, BoxDims>;
 absl::StatusOr<DetectorOptions> DetectorOptionsFromRequest(const v1::DetectRequest& request,
                                                            const DetectorOptions& defaults,
                                                            const BoxModels& models = {});
-
-// Applies the set fields of `overrides` to *options (a request's
-// overrides, or the server configuration's detector_defaults); the caller
-// validates the result.
-void ApplyDetectorOverrides(const v1::DetectorOverrides& overrides, DetectorOptions* options);
+// The same for a stream: its box and overrides validate exactly as Detect's.
+absl::StatusOr<DetectorOptions> DetectorOptionsFromRequest(
+    const v1::StreamDetectionsRequest& request, const DetectorOptions& defaults,
+    const BoxModels& models = {});
 
 }  // namespace cornerpose::server

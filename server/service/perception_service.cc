@@ -9,8 +9,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
-#include "server/conversion.h"
 #include "server/service/detect_request.h"
+#include "server/service/detect_response.h"
 #include "server/service/status_mapping.h"
 #include "server/service/stream_detections.h"
 
@@ -72,12 +72,17 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, const v1::DetectReq
   absl::StatusOr<PointCloud> sent;
   const PointCloud* cloud = nullptr;
   if (request.input_case() == v1::DetectRequest::kSource) {
+    if (request.has_color()) {
+      return ToGrpcStatus(absl::InvalidArgumentError(
+          "color is for a cloud or depth_image sent with the request; a source's frames bring "
+          "their own"));
+    }
     absl::StatusOr<Frame> grabbed = GrabFromSource(sources, request.source(), context);
     if (!grabbed.ok()) return ToGrpcStatus(grabbed.status());
     frame = *std::move(grabbed);
     cloud = &frame->cloud;
     // The source knows its camera; the request's intrinsics do not apply.
-    if (frame->camera) options->camera = frame->camera;
+    UseFrameCamera(frame->camera, &*options);
   } else {
     sent = CloudFromRequest(request);
     if (!sent.ok()) return ToGrpcStatus(sent.status());
@@ -89,8 +94,9 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, const v1::DetectReq
   if (!detection.ok()) return ToGrpcStatus(detection.status());
 
   if (grpc::Status s = CheckStillWanted(context); !s.ok()) return s;
-  response = DetectionToProto(*detection, request.include_edge_points());
-  if (frame) AddFrameToProto(*frame, {.include_cloud = request.include_cloud()}, &response);
+  response = MakeDetectResponse(*detection, *options, frame ? &*frame : nullptr,
+                                {.include_edge_points = request.include_edge_points(),
+                                 .include_cloud = request.include_cloud()});
   return grpc::Status::OK;
 }
 
@@ -140,23 +146,18 @@ namespace cornerpose::server {
 
 grpc::ServerWriteReactor<v1::DetectResponse>* PerceptionServiceImpl::StreamDetections(
     grpc::CallbackServerContext* /*context*/, const v1::StreamDetectionsRequest* request) {
-  // The box and overrides validate exactly as Detect's.
-  v1::DetectRequest as_detect;
-  as_detect.set_source(request->source());
-  if (request->has_box()) *as_detect.mutable_box() = request->box();
-  if (request->has_box_model()) as_detect.set_box_model(request->box_model());
-  *as_detect.mutable_overrides() = request->overrides();
   absl::StatusOr<DetectorOptions> options =
-      DetectorOptionsFromRequest(as_detect, defaults_, box_models_);
+      DetectorOptionsFromRequest(*request, defaults_, box_models_);
   if (!options.ok()) return new StreamDetectionsReactor(ToGrpcStatus(options.status()));
   auto it = sources_.find(request->source());
   if (it == sources_.end()) {
     return new StreamDetectionsReactor(ToGrpcStatus(
         absl::NotFoundError(absl::StrCat("unknown source '", request->source(), "'"))));
   }
-  return new StreamDetectionsReactor(
-      pool_, it->second.get(), *std::move(options), request->include_edge_points(),
-      {.include_cloud = request->include_cloud()}, &stopping_streams_);
+  return new StreamDetectionsReactor(pool_, it->second.get(), *std::move(options),
+                                     {.include_edge_points = request->include_edge_points(),
+                                      .include_cloud = request->include_cloud()},
+                                     &stopping_streams_);
 }
 
 }  // namespace cornerpose::server

@@ -4,7 +4,6 @@
 #include <utility>
 
 #include "absl/time/clock.h"
-#include "server/conversion.h"
 #include "server/service/status_mapping.h"
 
 namespace cornerpose::server {
@@ -18,13 +17,11 @@ constexpr absl::Duration kPollPeriod = absl::Milliseconds(100);
 StreamDetectionsReactor::StreamDetectionsReactor(const grpc::Status& error) { Finish(error); }
 
 StreamDetectionsReactor::StreamDetectionsReactor(DetectionPool* pool, FrameSource* source,
-                                                 DetectorOptions options, bool include_edge_points,
-                                                 FrameContents contents,
+                                                 DetectorOptions options, ResponseContents contents,
                                                  const std::atomic<bool>* stopping)
     : pool_(pool),
       source_(source),
       options_(std::move(options)),
-      include_edge_points_(include_edge_points),
       contents_(contents),
       stopping_(stopping) {
   thread_ = std::thread([this] { Run(); });
@@ -87,15 +84,14 @@ void StreamDetectionsReactor::Run() {
     std::promise<absl::StatusOr<Detection>> done;
     std::future<absl::StatusOr<Detection>> detection = done.get_future();
     DetectorOptions options = options_;
-    if (frame->camera) options.camera = frame->camera;  // as Detect does
+    UseFrameCamera(frame->camera, &options);  // as Detect does
     pool_->Submit([&] { done.set_value(DetectBoxes(frame->cloud, options)); });
     absl::StatusOr<Detection> result = detection.get();
     if (!result.ok()) {
       end = ToGrpcStatus(result.status());
       break;
     }
-    response_ = DetectionToProto(*result, include_edge_points_);
-    AddFrameToProto(*frame, contents_, &response_);
+    response_ = MakeDetectResponse(*result, options, &*frame, contents_);
 
     std::unique_lock<std::mutex> lock(mutex_);
     write_pending_ = true;

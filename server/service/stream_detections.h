@@ -9,7 +9,7 @@
 
 #include "common/perception/detector.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
-#include "server/conversion.h"
+#include "server/service/detect_response.h"
 #include "server/service/detection_pool.h"
 #include "server/sources/frame_source.h"
 
@@ -27,8 +27,7 @@ class StreamDetectionsReactor final : public grpc::ServerWriteReactor<v1::Detect
   // Streams until cancelled, the source ends or fails, or *stopping is set
   // (server shutdown). Everything pointed to outlives the RPC.
   StreamDetectionsReactor(DetectionPool* pool, FrameSource* source, DetectorOptions options,
-                          bool include_edge_points, FrameContents contents,
-                          const std::atomic<bool>* stopping);
+                          ResponseContents contents, const std::atomic<bool>* stopping);
 
   void OnWriteDone(bool ok) override;
   void OnCancel() override;
@@ -42,8 +41,7 @@ class StreamDetectionsReactor final : public grpc::ServerWriteReactor<v1::Detect
   DetectionPool* pool_ = nullptr;
   FrameSource* source_ = nullptr;
   const DetectorOptions options_;
-  const bool include_edge_points_ = false;
-  const FrameContents contents_;
+  const ResponseContents contents_;
   const std::atomic<bool>* stopping_ = nullptr;
 
   std::mutex mutex_;

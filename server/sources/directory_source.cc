@@ -10,8 +10,10 @@
 #include <utility>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "common/io/cloud_io.h"
+#include "common/io/png_io.h"
 
 namespace cornerpose::server {
 namespace {
@@ -22,6 +24,51 @@ struct Listing {
   std::vector<std::string> files;  // *.pcd and *.png, in name order
   bool has_png = false;
 };
+
+// NAME.color.png is the colour of frame NAME, never a depth frame.
+constexpr absl::string_view kColorSuffix = ".color.png";
+
+bool IsColorImage(const fs::path& path) {
+  return absl::EndsWithIgnoreCase(path.filename().string(), kColorSuffix);
+}
+
+// The colour image beside a frame: NAME.color.png for NAME.png or NAME.pcd.
+fs::path ColorPathFor(const fs::path& frame) {
+  fs::path color = frame;
+  color.replace_extension();
+  return color.string() + std::string(kColorSuffix);
+}
+
+// Attaches NAME.color.png, when there is one, to the frame's cloud as
+// PointCloud::rgb (packed 0x00RRGGBB). A cloud that has colour already (a
+// PCD with rgb fields) keeps it. A colour image that does not load or does
+// not match the frame's size is reported and the frame plays without it:
+// depth alone still detects.
+void AttachColor(const fs::path& frame, PointCloud* cloud, absl::string_view source) {
+  if (cloud->has_color()) return;
+  const fs::path color_path = ColorPathFor(frame);
+  std::error_code error;
+  if (!fs::exists(color_path, error)) return;
+  int width = 0;
+  int height = 0;
+  absl::StatusOr<std::vector<uint8_t>> rgb = ReadRgbPng(color_path.string(), &width, &height);
+  if (!rgb.ok()) {
+    std::cerr << "source " << source << ": " << color_path.string()
+              << ": colour not used: " << rgb.status().message() << "\n";
+    return;
+  }
+  if (width != cloud->width || height != cloud->height) {
+    std::cerr << "source " << source << ": " << color_path.string()
+              << ": colour not used: " << width << " x " << height << " but the frame is "
+              << cloud->width << " x " << cloud->height << "\n";
+    return;
+  }
+  cloud->rgb.resize(cloud->size());
+  for (size_t i = 0; i < cloud->rgb.size(); ++i) {
+    cloud->rgb[i] = (uint32_t{(*rgb)[3 * i]} << 16) | (uint32_t{(*rgb)[3 * i + 1]} << 8) |
+                    uint32_t{(*rgb)[3 * i + 2]};
+  }
+}
 
 absl::StatusOr<Listing> ListFrames(const std::string& directory) {
   std::error_code error;
@@ -34,6 +81,7 @@ absl::StatusOr<Listing> ListFrames(const std::string& directory) {
   for (const fs::directory_entry& entry : it) {
     const std::string extension = absl::AsciiStrToLower(entry.path().extension().string());
     if (extension != ".pcd" && extension != ".png") continue;
+    if (IsColorImage(entry.path())) continue;
     listing.has_png |= extension == ".png";
     listing.files.push_back(entry.path().string());
   }
@@ -118,6 +166,7 @@ void DirectorySource::Run() {
       any_loaded = true;
       Frame frame;
       frame.cloud = *std::move(cloud);
+      AttachColor(path, &frame.cloud, name_);
       if (absl::AsciiStrToLower(fs::path(path).extension().string()) == ".png") {
         frame.camera = load_options.intrinsics;
       }

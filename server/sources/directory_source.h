@@ -21,7 +21,9 @@ struct DirectorySourceOptions {
 
 // Frames are the directory's *.pcd files (LoadPointCloud) and *.png 16-bit
 // depth images in millimetres, back-projected through the directory's
-// intrinsics.txt ("width,height,fx,fy,cx,cy"), in file-name order. A file
+// intrinsics.txt ("width,height,fx,fy,cx,cy"), in file-name order. NAME.color.png
+// beside NAME.png (or NAME.pcd) is that frame's colour, registered to it
+// (PointCloud::rgb), and never a frame itself. A file
 // that fails to load is skipped (and logged to stderr); the source keeps
 // going. A directory that cannot be read, holds no frame files, or where no
 // file loads puts the source in kFailed with the reason, so a misconfigured

@@ -1,5 +1,3 @@
-#include "server/conversion.h"
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -9,7 +7,13 @@
 #include <string>
 #include <vector>
 
-namespace cornerpose::server {
+#include "common/perception/detector.h"
+#include "common/wire/box_wire.h"
+#include "common/wire/cloud_wire.h"
+#include "common/wire/detection_wire.h"
+#include "common/wire/geometry_wire.h"
+
+namespace cornerpose::wire {
 namespace {
 
 using ::testing::HasSubstr;
@@ -246,5 +250,176 @@ TEST(DetectionToProtoTest, EdgePointsOnlyWhenAsked) {
   EXPECT_EQ(with.edge_points(0).z(), 3.0);
 }
 
+TEST(DetectionFromProtoTest, RoundTripKeepsBoxesSegmentsAndTimings) {
+  Detection detection;
+  DetectedBox box;
+  box.camera_T_box.linear() =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  box.camera_T_box.translation() = Eigen::Vector3d(0.1, 0.2, 1.1);
+  box.score = 0.9;
+  box.grasp_face = BoxFace::kPlusY;
+  box.grasp_centre_camera = Eigen::Vector3d(0.1, 0.1, 1.0);
+  detection.boxes.push_back(box);
+  EdgeSegment segment;
+  segment.end1 = Eigen::Vector3f(0, 0, 1);
+  segment.end2 = Eigen::Vector3f(0.2f, 0, 1);
+  segment.num_points = 12;
+  detection.segments.push_back(segment);
+  detection.timings.poses_ms = 3.5;
+
+  absl::StatusOr<Detection> back = DetectionFromProto(DetectionToProto(detection, false));
+  ASSERT_TRUE(back.ok()) << back.status();
+  ASSERT_EQ(back->boxes.size(), 1u);
+  EXPECT_TRUE(back->boxes[0].camera_T_box.isApprox(box.camera_T_box, 1e-12));
+  EXPECT_EQ(back->boxes[0].grasp_face, BoxFace::kPlusY);
+  EXPECT_EQ(back->boxes[0].score, 0.9);
+  ASSERT_EQ(back->segments.size(), 1u);
+  EXPECT_TRUE(back->segments[0].direction.isApprox(Eigen::Vector3f::UnitX()));
+  EXPECT_EQ(back->segments[0].num_points, 12);
+  EXPECT_EQ(back->timings.poses_ms, 3.5);
+}
+
+TEST(BoxesFromProtoTest, ErrorsNameTheBox) {
+  v1::DetectResponse response;
+  response.add_boxes()->mutable_camera_pose_box()->mutable_orientation()->set_w(1);
+  response.mutable_boxes(0)->set_grasp_face(v1::BOX_FACE_PLUS_Z);
+  response.add_boxes();  // zero quaternion
+  absl::Status s = BoxesFromProto(response).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("boxes[1].camera_pose_box.orientation is not a rotation"));
+
+  response.mutable_boxes(1)->mutable_camera_pose_box()->mutable_orientation()->set_w(2);
+  s = BoxesFromProto(response).status();
+  EXPECT_THAT(s.message(), HasSubstr("boxes[1].grasp_face 0 is not a box face"));
+
+  response.mutable_boxes(1)->set_grasp_face(v1::BOX_FACE_MINUS_X);
+  absl::StatusOr<std::vector<DetectedBox>> boxes = BoxesFromProto(response);
+  ASSERT_TRUE(boxes.ok()) << boxes.status();
+  ASSERT_EQ(boxes->size(), 2u);
+  // A non-unit quaternion from a peer is normalised.
+  EXPECT_TRUE((*boxes)[1].camera_T_box.linear().isApprox(Eigen::Matrix3d::Identity()));
+  EXPECT_EQ((*boxes)[1].grasp_face, BoxFace::kMinusX);
+}
+
+TEST(PoseFromProtoTest, ConfigurationPosesNeedUnitQuaternions) {
+  v1::Pose pose;
+  pose.mutable_orientation()->set_w(0.5);
+  absl::Status s = PoseFromProto(pose, "base_pose_camera").status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(),
+              HasSubstr("base_pose_camera.orientation must be a unit quaternion (w x y z), got "
+                        "norm 0.5"));
+  EXPECT_TRUE(PoseFromProto(pose, "x", OrientationCheck::kNonZero).ok());
+
+  pose.mutable_orientation()->set_w(1.0);
+  pose.mutable_position()->set_y(std::numeric_limits<double>::infinity());
+  s = PoseFromProto(pose, "place_pattern.origin").status();
+  EXPECT_THAT(s.message(), HasSubstr("place_pattern.origin.position is not finite"));
+
+  pose.mutable_position()->set_y(0.25);
+  absl::StatusOr<Eigen::Isometry3d> T = PoseFromProto(pose, "p");
+  ASSERT_TRUE(T.ok()) << T.status();
+  EXPECT_EQ(T->translation().y(), 0.25);
+}
+
+TEST(BoxDimsTest, BothWays) {
+  const v1::BoxDimensions proto = ToProto(BoxDims{0.3, 0.2, 0.15});
+  EXPECT_EQ(proto.l(), 0.3);
+  EXPECT_EQ(proto.b(), 0.2);
+  EXPECT_EQ(proto.h(), 0.15);
+  EXPECT_EQ(BoxDimsFromProto(proto).vec(), Eigen::Vector3d(0.3, 0.2, 0.15));
+}
+
+TEST(BoxModelsFromProtoTest, NamesAndSizesAreChecked) {
+  google::protobuf::Map<std::string, v1::BoxDimensions> models;
+  models["crate"] = ToProto(BoxDims{0.5, 0.4, 0.3});
+  absl::StatusOr<BoxModels> ok = BoxModelsFromProto(models);
+  ASSERT_TRUE(ok.ok()) << ok.status();
+  EXPECT_EQ(ok->at("crate").l, 0.5);
+
+  models["flat"] = ToProto(BoxDims{0.5, 0.0, 0.3});
+  EXPECT_THAT(BoxModelsFromProto(models).status().message(),
+              HasSubstr("box_models[\"flat\"]: l, b and h must be > 0 metres"));
+  models.erase("flat");
+  models[""] = ToProto(BoxDims{0.5, 0.4, 0.3});
+  EXPECT_THAT(BoxModelsFromProto(models).status().message(),
+              HasSubstr("box_models: empty model name"));
+}
+
+TEST(ColorTest, CloudRgbRoundTrips) {
+  PointCloud cloud;
+  cloud.width = 2;
+  cloud.height = 1;
+  cloud.xyz = {{0, 0, 1}, {0.1f, 0, 1}};
+  cloud.rgb = {0x00112233u, 0x00ff8000u};
+  const v1::PointCloud msg = CloudToProto(cloud);
+  EXPECT_EQ(msg.rgb(), std::string("\x11\x22\x33\xff\x80\x00", 6));
+  absl::StatusOr<PointCloud> back = CloudFromProto(msg);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->rgb, cloud.rgb);
+
+  // Depth only: no rgb on the wire, none back.
+  cloud.rgb.clear();
+  EXPECT_TRUE(CloudToProto(cloud).rgb().empty());
+  EXPECT_FALSE(CloudFromProto(CloudToProto(cloud))->has_color());
+}
+
+TEST(ColorTest, CloudRgbMustBeThreeBytesPerPoint) {
+  v1::PointCloud msg;
+  msg.set_xyz(Pack({{0, 0, 1}, {0, 0, 2}}));
+  msg.set_width(2);
+  msg.set_height(1);
+  msg.set_rgb("abcd");
+  absl::Status s = CloudFromProto(msg).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("cloud rgb has 4 bytes; 2 points of 3 bytes need 6"));
+}
+
+TEST(ColorTest, RgbAndGreyImagesPack) {
+  v1::ColorImage image;
+  image.set_width(2);
+  image.set_height(1);
+  image.set_encoding(v1::COLOR_ENCODING_RGB8);
+  image.set_data(std::string("\x01\x02\x03\xfa\xfb\xfc", 6));
+  absl::StatusOr<std::vector<uint32_t>> rgb = ColorFromProto(image, 2, 1);
+  ASSERT_TRUE(rgb.ok()) << rgb.status();
+  EXPECT_EQ(*rgb, (std::vector<uint32_t>{0x00010203u, 0x00fafbfcu}));
+
+  image.set_encoding(v1::COLOR_ENCODING_GRAY8);
+  image.set_data(std::string("\x10\xf0", 2));
+  rgb = ColorFromProto(image, 2, 1);
+  ASSERT_TRUE(rgb.ok()) << rgb.status();
+  EXPECT_EQ(*rgb, (std::vector<uint32_t>{0x00101010u, 0x00f0f0f0u}));
+}
+
+TEST(ColorTest, RefusalsNameTheField) {
+  v1::ColorImage image;
+  image.set_width(2);
+  image.set_height(2);
+  image.set_encoding(v1::COLOR_ENCODING_RGB8);
+  image.set_data(std::string(12, '\0'));
+  EXPECT_THAT(ColorFromProto(image, 4, 1).status().message(),
+              HasSubstr("color is 2 x 2 but the cloud is 4 x 1"));
+  image.set_data(std::string(11, '\0'));
+  EXPECT_THAT(ColorFromProto(image, 2, 2).status().message(),
+              HasSubstr("color data has 11 bytes; 2 x 2 pixels of 3 bytes need 12"));
+  image.set_encoding(v1::COLOR_ENCODING_UNSPECIFIED);
+  EXPECT_THAT(ColorFromProto(image, 2, 2).status().message(),
+              HasSubstr("color encoding 0 is not COLOR_ENCODING_RGB8 or COLOR_ENCODING_GRAY8"));
+}
+
+TEST(IntrinsicsTest, BothWays) {
+  CameraIntrinsics k;
+  k.width = 320;
+  k.fx = 300.5;
+  k.cy = 119.5;
+  absl::StatusOr<CameraIntrinsics> back = IntrinsicsFromProto(ToProto(k));
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->width, 320);
+  EXPECT_EQ(back->height, k.height);
+  EXPECT_EQ(back->fx, 300.5);
+  EXPECT_EQ(back->cy, 119.5);
+}
+
 }  // namespace
-}  // namespace cornerpose::server
+}  // namespace cornerpose::wire

@@ -1,18 +1,16 @@
-// The client side of the wire format: a DetectResponse converted back into
-// the detector's types (server/conversion.h goes the other way, and packs
-// clouds for both sides).
+// A detection between the detector's types and DetectResponse, both ways:
+// what the server sends and what its clients (the CLI, the tests) read back.
+// The daemon, which needs only the boxes, uses BoxesFromProto (box_wire.h).
 #pragma once
 
 #include "absl/status/statusor.h"
 #include "common/perception/types.h"
-#include "cornerpose/v1/geometry.pb.h"
 #include "cornerpose/v1/perception_service.pb.h"
 
-namespace cornerpose::tools {
+namespace cornerpose::wire {
 
-// The inverse of server::ToProto(BoxFace). INVALID_ARGUMENT for
-// BOX_FACE_UNSPECIFIED or an unknown value.
-absl::StatusOr<BoxFace> BoxFaceFromProto(v1::BoxFace face);
+// Boxes, segments, corners and timings; the edge points only when asked.
+v1::DetectResponse DetectionToProto(const Detection& detection, bool include_edge_points);
 
 // Boxes (pose from position + unit quaternion), segments (the line point and
 // direction rebuilt from the extremities), corners (without the segment
@@ -21,4 +19,4 @@ absl::StatusOr<BoxFace> BoxFaceFromProto(v1::BoxFace face);
 // unspecified grasp face.
 absl::StatusOr<Detection> DetectionFromProto(const v1::DetectResponse& response);
 
-}  // namespace cornerpose::tools
+}  // namespace cornerpose::wire

@@ -1,4 +1,4 @@
-#include "common/perception/box_models.h"
+#include "common/box/box_models.h"
 
 #include <array>
 #include <string>
@@ -31,6 +31,11 @@ absl::StatusOr<BoxDims> BoxModelByName(absl::string_view name) {
   for (const auto& [model, dims] : kModels)
     absl::StrAppend(&known, known.empty() ? "" : ", ", model);
   return absl::NotFoundError(absl::StrCat("unknown box model '", name, "' (known: ", known, ")"));
+}
+
+absl::StatusOr<BoxDims> ResolveBoxModel(absl::string_view name, const BoxModels& models) {
+  if (auto it = models.find(std::string(name)); it != models.end()) return it->second;
+  return BoxModelByName(name);
 }
 
 absl::StatusOr<BoxDims> ParseBoxDims(absl::string_view text) {

@@ -1,24 +1,29 @@
-#include "server/conversion.h"
+#include "common/wire/cloud_wire.h"
 
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <string>
-#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "common/io/cloud_io.h"
+#include "common/perception/detector.h"
 
-namespace cornerpose::server {
+namespace cornerpose::wire {
 namespace {
 
 // The wire format is little-endian; reading it with memcpy is only right on
 // a little-endian host, which every target of this service is.
 static_assert(std::endian::native == std::endian::little,
-              "conversion.cc reads little-endian wire data with memcpy");
+              "cloud_wire.cc reads little-endian wire data with memcpy");
 
 constexpr size_t kBytesPerPoint = 3 * sizeof(float);
+constexpr size_t kBytesPerColour = 3;
+
+uint32_t PackRgb(uint8_t r, uint8_t g, uint8_t b) {
+  return (uint32_t{r} << 16) | (uint32_t{g} << 8) | uint32_t{b};
+}
 
 // width * height, or an error naming both when it is not the point count.
 absl::Status CheckGrid(uint64_t width, uint64_t height, uint64_t count, absl::string_view what) {
@@ -42,6 +47,15 @@ v1::PointCloud CloudToProto(const PointCloud& cloud) {
   msg.set_xyz(std::move(bytes));
   msg.set_width(static_cast<uint32_t>(cloud.width));
   msg.set_height(static_cast<uint32_t>(cloud.height));
+  if (cloud.has_color()) {
+    std::string rgb(cloud.rgb.size() * kBytesPerColour, '\0');
+    for (size_t i = 0; i < cloud.rgb.size(); ++i) {
+      rgb[i * 3 + 0] = static_cast<char>((cloud.rgb[i] >> 16) & 0xff);
+      rgb[i * 3 + 1] = static_cast<char>((cloud.rgb[i] >> 8) & 0xff);
+      rgb[i * 3 + 2] = static_cast<char>(cloud.rgb[i] & 0xff);
+    }
+    msg.set_rgb(std::move(rgb));
+  }
   return msg;
 }
 
@@ -58,6 +72,11 @@ absl::StatusOr<PointCloud> CloudFromProto(const v1::PointCloud& cloud) {
         absl::StrCat("cloud has ", count, " points, above the limit of ", kMaxPoints));
   }
   if (absl::Status s = CheckGrid(cloud.width(), cloud.height(), count, "cloud"); !s.ok()) return s;
+  if (!cloud.rgb().empty() && cloud.rgb().size() != count * kBytesPerColour) {
+    return absl::InvalidArgumentError(absl::StrCat("cloud rgb has ", cloud.rgb().size(), " bytes; ",
+                                                   count, " points of 3 bytes need ",
+                                                   count * kBytesPerColour));
+  }
 
   PointCloud out;
   out.width = static_cast<int>(cloud.width());
@@ -69,6 +88,11 @@ absl::StatusOr<PointCloud> CloudFromProto(const v1::PointCloud& cloud) {
     float p[3];
     std::memcpy(p, bytes.data() + i * kBytesPerPoint, kBytesPerPoint);
     out.xyz[i] = Eigen::Vector3f(p[0], p[1], p[2]);
+  }
+  if (!cloud.rgb().empty()) {
+    const auto* c = reinterpret_cast<const uint8_t*>(cloud.rgb().data());
+    out.rgb.resize(count);
+    for (uint64_t i = 0; i < count; ++i) out.rgb[i] = PackRgb(c[3 * i], c[3 * i + 1], c[3 * i + 2]);
   }
   return out;
 }
@@ -88,6 +112,17 @@ absl::StatusOr<CameraIntrinsics> IntrinsicsFromProto(const v1::CameraIntrinsics&
   out.cx = in.cx();
   out.cy = in.cy();
   if (absl::Status s = out.Validate(); !s.ok()) return s;
+  return out;
+}
+
+v1::CameraIntrinsics ToProto(const CameraIntrinsics& intrinsics) {
+  v1::CameraIntrinsics out;
+  out.set_width(static_cast<uint32_t>(intrinsics.width));
+  out.set_height(static_cast<uint32_t>(intrinsics.height));
+  out.set_fx(intrinsics.fx);
+  out.set_fy(intrinsics.fy);
+  out.set_cx(intrinsics.cx);
+  out.set_cy(intrinsics.cy);
   return out;
 }
 
@@ -157,93 +192,40 @@ absl::StatusOr<PointCloud> CloudFromDepthImage(const v1::DepthImage& image,
   return cloud;
 }
 
-BoxDims BoxDimsFromProto(const v1::BoxDimensions& box) { return {box.l(), box.b(), box.h()}; }
-
-v1::Vector3 ToProto(const Eigen::Vector3d& v) {
-  v1::Vector3 out;
-  out.set_x(v.x());
-  out.set_y(v.y());
-  out.set_z(v.z());
-  return out;
-}
-
-v1::Vector3 ToProto(const Eigen::Vector3f& v) { return ToProto(Eigen::Vector3d(v.cast<double>())); }
-
-v1::Quaternion ToProto(const Eigen::Quaterniond& q) {
-  Eigen::Quaterniond unit = q.normalized();
-  if (unit.w() < 0.0) unit.coeffs() = -unit.coeffs();
-  v1::Quaternion out;
-  out.set_w(unit.w());
-  out.set_x(unit.x());
-  out.set_y(unit.y());
-  out.set_z(unit.z());
-  return out;
-}
-
-v1::Pose ToProto(const Eigen::Isometry3d& parent_T_child) {
-  v1::Pose out;
-  *out.mutable_position() = ToProto(Eigen::Vector3d(parent_T_child.translation()));
-  *out.mutable_orientation() = ToProto(Eigen::Quaterniond(parent_T_child.rotation()));
-  return out;
-}
-
-v1::BoxFace ToProto(BoxFace face) {
-  switch (face) {
-    case BoxFace::kPlusX:
-      return v1::BOX_FACE_PLUS_X;
-    case BoxFace::kMinusX:
-      return v1::BOX_FACE_MINUS_X;
-    case BoxFace::kPlusY:
-      return v1::BOX_FACE_PLUS_Y;
-    case BoxFace::kMinusY:
-      return v1::BOX_FACE_MINUS_Y;
-    case BoxFace::kPlusZ:
-      return v1::BOX_FACE_PLUS_Z;
-    case BoxFace::kMinusZ:
-      return v1::BOX_FACE_MINUS_Z;
+absl::StatusOr<std::vector<uint32_t>> ColorFromProto(const v1::ColorImage& color, int width,
+                                                     int height) {
+  if (color.width() != static_cast<uint32_t>(width) ||
+      color.height() != static_cast<uint32_t>(height)) {
+    return absl::InvalidArgumentError(absl::StrCat("color is ", color.width(), " x ",
+                                                   color.height(), " but the cloud is ", width,
+                                                   " x ", height, " (it must be registered)"));
   }
-  return v1::BOX_FACE_UNSPECIFIED;
+  size_t pixel_bytes = 0;
+  switch (color.encoding()) {
+    case v1::COLOR_ENCODING_RGB8:
+      pixel_bytes = 3;
+      break;
+    case v1::COLOR_ENCODING_GRAY8:
+      pixel_bytes = 1;
+      break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat("color encoding ", color.encoding(),
+                       " is not COLOR_ENCODING_RGB8 or COLOR_ENCODING_GRAY8"));
+  }
+  const uint64_t pixels = uint64_t{color.width()} * color.height();
+  if (color.data().size() != pixels * pixel_bytes) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "color data has ", color.data().size(), " bytes; ", color.width(), " x ", color.height(),
+        " pixels of ", pixel_bytes, " bytes need ", pixels * pixel_bytes));
+  }
+  const auto* c = reinterpret_cast<const uint8_t*>(color.data().data());
+  std::vector<uint32_t> rgb(pixels);
+  for (uint64_t i = 0; i < pixels; ++i) {
+    rgb[i] = pixel_bytes == 3 ? PackRgb(c[3 * i], c[3 * i + 1], c[3 * i + 2])
+                              : PackRgb(c[i], c[i], c[i]);
+  }
+  return rgb;
 }
 
-v1::DetectResponse DetectionToProto(const Detection& detection, bool include_edge_points) {
-  v1::DetectResponse out;
-  for (const DetectedBox& box : detection.boxes) {
-    v1::DetectedBox* b = out.add_boxes();
-    *b->mutable_camera_pose_box() = ToProto(box.camera_T_box);
-    b->set_score(box.score);
-    b->set_grasp_face(ToProto(box.grasp_face));
-    *b->mutable_grasp_centre() = ToProto(box.grasp_centre_camera);
-    *b->mutable_grasp_normal() = ToProto(box.grasp_normal_camera);
-  }
-  for (const EdgeSegment& segment : detection.segments) {
-    v1::EdgeSegment* s = out.add_segments();
-    *s->mutable_end1() = ToProto(segment.end1);
-    *s->mutable_end2() = ToProto(segment.end2);
-    s->set_num_points(static_cast<uint32_t>(segment.num_points));
-  }
-  for (const Corner& corner : detection.corners) {
-    *out.add_corners()->mutable_position() = ToProto(corner.position);
-  }
-  if (include_edge_points) {
-    out.mutable_edge_points()->Reserve(static_cast<int>(detection.edge_points.size()));
-    for (const Eigen::Vector3f& p : detection.edge_points) *out.add_edge_points() = ToProto(p);
-  }
-  v1::StageTimings* t = out.mutable_timings();
-  t->set_preprocess_ms(detection.timings.preprocess_ms);
-  t->set_edge_points_ms(detection.timings.edge_points_ms);
-  t->set_edge_segments_ms(detection.timings.edge_segments_ms);
-  t->set_clubbing_ms(detection.timings.clubbing_ms);
-  t->set_poses_ms(detection.timings.poses_ms);
-  t->set_total_ms(detection.timings.total_ms);
-  return out;
-}
-
-void AddFrameToProto(const Frame& frame, const FrameContents& contents,
-                     v1::DetectResponse* response) {
-  response->set_frame_id(frame.id);
-  response->set_capture_time_unix_nanos(absl::ToUnixNanos(frame.capture_time));
-  response->set_source(frame.source);
-  if (contents.include_cloud) *response->mutable_cloud() = CloudToProto(frame.cloud);
-}
-
-}  // namespace cornerpose::server
+}  // namespace cornerpose::wire
