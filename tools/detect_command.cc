@@ -131,12 +131,7 @@ void PrintDetection(const std::string& label, std::optional<size_t> num_points,
 }
 
 int RunDetect(const std::vector<std::string>& argv) {
-  for (const std::string& a : argv) {
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-  }
+  if (PrintHelpIfAsked(argv, kHelp)) return 0;
   absl::StatusOr<CommandArgs> args = ParseCommandArgs(
       argv,
       {"cloud", "box", "intrinsics", "json", "ply", "png", "edges", "radius", "threshold",

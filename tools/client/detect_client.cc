@@ -111,12 +111,7 @@ absl::Status Detect(const CommandArgs& args) {
 }  // namespace
 
 int RunClientDetect(const std::vector<std::string>& argv) {
-  for (const std::string& a : argv) {
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-  }
+  if (PrintHelpIfAsked(argv, kHelp)) return 0;
   absl::StatusOr<CommandArgs> args =
       ParseCommandArgs(argv,
                        {"server", "cloud", "source", "box", "intrinsics", "json", "ply", "png",

@@ -133,12 +133,7 @@ absl::Status Stream(const CommandArgs& args) {
 }  // namespace
 
 int RunClientStream(const std::vector<std::string>& argv) {
-  for (const std::string& a : argv) {
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-  }
+  if (PrintHelpIfAsked(argv, kHelp)) return 0;
   absl::StatusOr<CommandArgs> args = ParseCommandArgs(
       argv, {"server", "source", "box", "frames", "json", "ply", "png", "edges", "deadline_ms"},
       {"quiet"}, {"server", "source", "box"});
