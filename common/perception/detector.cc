@@ -11,6 +11,7 @@
 #include "common/perception/internal/box_overlap.h"
 #include "common/perception/internal/hypothesis_judge.h"
 #include "common/perception/neighbour_hypotheses.h"
+#include "common/validation/range_check.h"
 
 namespace cornerpose {
 namespace {
@@ -46,14 +47,19 @@ const PointCloud& SanitizeCloud(const PointCloud& cloud, PointCloud* storage) {
 }  // namespace
 
 absl::Status AcceptanceOptions::Validate() const {
-  for (double v : {min_support, min_grasp_support, max_grasp_occluded, max_see_through}) {
-    if (!(v >= 0.0 && v <= 1.0)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("acceptance fraction ", v, " is outside [0, 1]"));
-    }
-  }
-  if (min_grasp_pixels < 1 || !(extent_tolerance_m > 0.0) || !(overlap_margin_m >= 0.0)) {
-    return absl::InvalidArgumentError("acceptance limits out of range");
+  for (absl::Status s : {
+           CheckRange("acceptance.min_support", min_support, 0.0, 1.0),
+           CheckRange("acceptance.min_grasp_support", min_grasp_support, 0.0, 1.0),
+           CheckRange("acceptance.max_grasp_occluded", max_grasp_occluded, 0.0, 1.0),
+           CheckRange("acceptance.max_occluded", max_occluded, 0.0, 1.0),
+           CheckRange("acceptance.max_see_through", max_see_through, 0.0, 1.0),
+           CheckRange("acceptance.min_grasp_pixels", min_grasp_pixels, 1, 1'000'000),
+           CheckPositive("acceptance.extent_tolerance_m", extent_tolerance_m, 1.0),
+           CheckRange("acceptance.max_grasp_view_angle_deg", max_grasp_view_angle_deg, 0.0, 90.0),
+           CheckRange("acceptance.border_margin_px", border_margin_px, 0.0, 1000.0),
+           CheckRange("acceptance.overlap_margin_m", overlap_margin_m, 0.0, 1.0),
+       }) {
+    if (!s.ok()) return s;
   }
   return absl::OkStatus();
 }
@@ -74,6 +80,15 @@ absl::Status DetectorOptions::Validate() const {
   }
   if (max_points < 1) return absl::InvalidArgumentError("max_points must be positive");
   return absl::OkStatus();
+}
+
+void SetEdgeRadius(double radius_m, DetectorOptions* options) {
+  options->edge_points.radius_m = radius_m;
+  options->segments.gap_m = radius_m;
+}
+
+void UseFrameCamera(const std::optional<CameraIntrinsics>& frame_camera, DetectorOptions* options) {
+  if (frame_camera) options->camera = frame_camera;
 }
 
 absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOptions& options_in) {
