@@ -4,7 +4,7 @@
 #include <cstdint>
 
 #include "fuzz/fuzz_input.h"
-#include "robot_client/robot_config.h"
+#include "robot_client/config/robot_config.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const cornerpose::fuzz::TempFile file("robot_client.textproto");

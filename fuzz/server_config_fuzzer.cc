@@ -4,7 +4,7 @@
 #include <cstdint>
 
 #include "fuzz/fuzz_input.h"
-#include "server/server_config.h"
+#include "server/config/server_config.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const cornerpose::fuzz::TempFile file("server.textproto");
