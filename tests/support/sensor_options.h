@@ -52,8 +52,8 @@ struct StereoOptions {
   // texture. Correlated over the matching window: white, window-scale and
   // blob-scale parts (shares of the variance, each [0, 1], summing to 1).
   double subpixel_px = 0.08;  // px, [0, 1]
-  double white_share = 0.25;
-  double window_share = 0.5;
+  double white_share = 0.1;
+  double window_share = 0.45;
   double window_correlation_px = 2.5;  // px, (0, 20]
   double blob_correlation_px = 9.0;    // px, (0, 50]
   // 6. Holes: random speckle holes where the projected texture is weak

@@ -60,6 +60,7 @@ std::vector<double> ApplyStereoNoise(const RayCaster& caster, const SurfaceTextu
     MinFilter1d(&filled, width, height, r_gap, along_x);
     MaxFilter1d(&filled, width, height, r_gap, along_x);
   }
+  const std::vector<double> depth_nominal_filled = filled;
   // 2. Edge fattening: the nearer side of every jump grows by fattening_px.
   std::vector<double> fat = filled;
   MinFilter1d(&fat, width, height, options.fattening_px, true);
@@ -99,26 +100,34 @@ std::vector<double> ApplyStereoNoise(const RayCaster& caster, const SurfaceTextu
   }
 
   // 4. No match where the right imager cannot see the surface: behind a
-  // nearer surface, or outside its image; widened towards the occluded side.
+  // nearer surface, or outside its image; widened towards the occluded side
+  // by the matching window (a ragged margin). Filled cracks are matched.
   const double fb = camera.fx * options.baseline_m;
+  std::vector<bool> gap_filled(n);
+  for (int i = 0; i < n; ++i) {
+    gap_filled[i] = std::isfinite(depth_nominal_filled[i]) &&
+                    depth_nominal_filled[i] < nominal[i].depth - options.jump_m;
+  }
   for (int i = 0; i < n; ++i) {
     if (status[i] != kValid) continue;
     const int u = i % width, v = i / width;
-    const Eigen::Vector3d p = depth[i] * caster.Ray(u, v);
     if (u - fb / depth[i] < 0.0) {
       status[i] = kOccluded;
-    } else if (!moved[i] && caster.ProjectorBlocked(p, nominal[i].object)) {
+    } else if (!gap_filled[i] && nominal[i].object != kNothing &&
+               caster.ProjectorBlocked(nominal[i].depth * caster.Ray(u, v), nominal[i].object)) {
       status[i] = kOccluded;
     }
   }
   if (options.occlusion_margin_px > 0) {
+    const std::vector<double> ragged = SmoothGaussianField(width, height, 2.0, rng);
     const std::vector<uint8_t> before = status;
     for (int v = 0; v < height; ++v) {
       for (int u = 0; u < width; ++u) {
         const int i = v * width + u;
         if (before[i] != kValid) continue;
         // A background pixel just left of an occluded run, within the margin.
-        for (int k = 1; k <= options.occlusion_margin_px && u + k < width; ++k) {
+        const int margin = std::max<int>(0, std::lround(options.occlusion_margin_px + 1.5 * ragged[i]));
+        for (int k = 1; k <= margin && u + k < width; ++k) {
           if (before[i + k] == kOccluded) {
             status[i] = kOccluded;
             break;
