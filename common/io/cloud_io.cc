@@ -102,6 +102,16 @@ absl::StatusOr<PointCloud> FromBlob(const pcl::PCLPointCloud2& blob, const std::
                                                    " points do not fit in ", blob.data.size(),
                                                    " bytes of data"));
   }
+  // Colour: a 4-byte rgb or rgba field, U (uint32) or F (the same bits in a
+  // float), packed 0xAARRGGBB; the alpha byte is dropped.
+  const pcl::PCLPointField* colour = nullptr;
+  for (const pcl::PCLPointField& f : blob.fields) {
+    if ((f.name == "rgb" || f.name == "rgba") && FieldBytes(f.datatype) == 4 &&
+        f.datatype != pcl::PCLPointField::INT8 && size_t{f.offset} + 4 <= blob.point_step) {
+      colour = &f;
+      break;
+    }
+  }
   PointCloud cloud;
   if (n == 0) return cloud;
   cloud.width = static_cast<int>(blob.width);
@@ -114,6 +124,14 @@ absl::StatusOr<PointCloud> FromBlob(const pcl::PCLPointCloud2& blob, const std::
       p[axis] = static_cast<float>(ReadValue(point + xyz[axis]->offset, xyz[axis]->datatype));
     }
     cloud.xyz[i] = p.allFinite() ? p : Eigen::Vector3f::Constant(kNaN);
+  }
+  if (colour != nullptr) {
+    cloud.rgb.resize(cloud.xyz.size());
+    for (size_t i = 0; i < cloud.rgb.size(); ++i) {
+      uint32_t packed;
+      std::memcpy(&packed, blob.data.data() + i * blob.point_step + colour->offset, 4);
+      cloud.rgb[i] = packed & 0x00FFFFFFu;
+    }
   }
   return cloud;
 }
@@ -167,7 +185,19 @@ absl::StatusOr<PointCloud> LoadDepthImage(const std::string& path, const LoadOpt
                                                    " but the intrinsics are for ", camera.width,
                                                    " x ", camera.height));
   }
-  return DepthToCloud(*depth, camera, options.depth_scale_m);
+  PointCloud cloud = DepthToCloud(*depth, camera, options.depth_scale_m);
+  // A colour image registered to the depth image: NAME.color.png beside
+  // NAME.png (the recorded-frame convention), used when it is there.
+  if (!options.color_path) {
+    const std::filesystem::path p(path);
+    const std::filesystem::path beside =
+        p.parent_path() / (p.stem().string() + ".color.png");
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(beside, ec)) {
+      if (absl::Status s = AttachColor(beside.string(), &cloud); !s.ok()) return s;
+    }
+  }
+  return cloud;
 }
 
 struct FileCloser {
@@ -176,9 +206,41 @@ struct FileCloser {
   }
 };
 
+absl::StatusOr<PointCloud> LoadCloudFile(const std::string& path, const LoadOptions& options);
+
 }  // namespace
 
 absl::StatusOr<PointCloud> LoadPointCloud(const std::string& path, const LoadOptions& options) {
+  absl::StatusOr<PointCloud> cloud = LoadCloudFile(path, options);
+  if (!cloud.ok() || !options.color_path) return cloud;
+  if (absl::Status s = AttachColor(*options.color_path, &*cloud); !s.ok()) return s;
+  return cloud;
+}
+
+absl::Status AttachColor(const std::string& path, PointCloud* cloud) {
+  if (!cloud->organized()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(path, ": a colour image needs an organized cloud to register to"));
+  }
+  int width = 0, height = 0;
+  absl::StatusOr<std::vector<uint8_t>> rgb = ReadRgbPng(path, &width, &height);
+  if (!rgb.ok()) return rgb.status();
+  if (width != cloud->width || height != cloud->height) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": colour image is ", width, " x ", height,
+                                                   " but the cloud is ", cloud->width, " x ",
+                                                   cloud->height));
+  }
+  cloud->rgb.resize(cloud->xyz.size());
+  for (size_t i = 0; i < cloud->rgb.size(); ++i) {
+    const uint8_t* c = rgb->data() + 3 * i;
+    cloud->rgb[i] = (uint32_t{c[0]} << 16) | (uint32_t{c[1]} << 8) | c[2];
+  }
+  return absl::OkStatus();
+}
+
+namespace {
+
+absl::StatusOr<PointCloud> LoadCloudFile(const std::string& path, const LoadOptions& options) {
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
   if (!std::filesystem::exists(status)) {
@@ -203,6 +265,8 @@ absl::StatusOr<PointCloud> LoadPointCloud(const std::string& path, const LoadOpt
                                                  "' (expected .pcd, .ply or a 16-bit depth .png)"));
 }
 
+}  // namespace
+
 PointCloud DepthToCloud(const std::vector<uint16_t>& depth, const CameraIntrinsics& camera,
                         double depth_scale_m) {
   PointCloud cloud;
@@ -216,7 +280,7 @@ PointCloud DepthToCloud(const std::vector<uint16_t>& depth, const CameraIntrinsi
   for (int v = 0; v < camera.height; ++v) {
     for (int u = 0; u < camera.width; ++u) {
       const size_t i = static_cast<size_t>(v) * camera.width + u;
-      if (depth[i] == 0) {
+      if (depth[i] == 0 || depth[i] == 65535) {  // no return (65535 on some stereo cameras)
         cloud.xyz[i] = Eigen::Vector3f::Constant(kNaN);
         continue;
       }

@@ -103,6 +103,21 @@ struct DetectedBox {
   Eigen::Vector3d grasp_normal_camera = Eigen::Vector3d::Zero();  // its outward normal
   std::vector<int> segments;  // edge segments that support the box
   int num_corners = 0;        // corners used for its pose
+  // The grasp face's size as measured between two ends (free sides or
+  // seams) along its two in-plane box axes, (n+1) % 3 and (n+2) % 3 for the
+  // face's normal axis n; 0 where a side was not measured. Metres.
+  std::array<double, 2> measured_extent_m{0.0, 0.0};
+  bool from_face = false;  // proposed by a planar patch (else by corners or a neighbour)
+};
+
+// A hypothesis the detector did not return, and why: what an integrator
+// reads to tune a cell ("face tiles two ways", "side runs on flat", ...).
+struct DeclinedCandidate {
+  Eigen::Isometry3d camera_T_box = Eigen::Isometry3d::Identity();
+  // Its render-and-compare support before refinement, in [0, 1]; 0 when it
+  // was declined before any (an ambiguous tiling).
+  double score = 0.0;
+  std::string reason;
 };
 
 // Wall-clock time of each stage, milliseconds.
@@ -111,6 +126,7 @@ struct StageTimings {
   double edge_points_ms = 0.0;
   double edge_segments_ms = 0.0;
   double clubbing_ms = 0.0;
+  double faces_ms = 0.0;  // planar patches and their tilings
   double poses_ms = 0.0;
   double total_ms = 0.0;
 };
@@ -129,6 +145,9 @@ struct Detection {
   std::vector<EdgeSegment> segments;
   std::vector<Corner> corners;
   std::vector<DetectedBox> boxes;  // best score first
+  // The strongest hypotheses not returned, strongest first, each with a
+  // reason (at most DetectorOptions::max_declined).
+  std::vector<DeclinedCandidate> declined;
   StageTimings timings;
   HypothesisStats hypotheses;
 };

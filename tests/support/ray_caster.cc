@@ -79,6 +79,11 @@ RayCaster::RayCaster(const Scene& scene, double projector_offset_m)
     const auto corners = BoxCorners(dims, camera_T_box);
     c.camera_rect = ProjectedRect(corners, Eigen::Vector3d::Zero(), camera_);
     c.projector_rect = ProjectedRect(corners, projector_, camera_);
+    c.lo = c.hi = corners[0];
+    for (const Eigen::Vector3d& corner : corners) {
+      c.lo = c.lo.cwiseMin(corner);
+      c.hi = c.hi.cwiseMax(corner);
+    }
     cuboids_.push_back(c);
   };
   for (const SceneBox& box : scene.boxes) add(box.dims, box.world_T_box);
@@ -149,6 +154,23 @@ bool RayCaster::ProjectorBlocked(const Eigen::Vector3d& point, int skip) const {
     // The segment is t in (0, 1); a point resting on this cuboid touches it
     // only at t ~ 0, which must not count.
     if (t_out > 1e-7 && t_in < 1.0 && t_out - std::max(t_in, 0.0) > 1e-9) return true;
+  }
+  return false;
+}
+
+bool RayCaster::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                         double max_t) const {
+  for (const Cuboid& c : cuboids_) {
+    // Bounds first: most cuboids are nowhere near the ray.
+    double t_in, t_out;
+    int axis;
+    const Eigen::Vector3d centre = 0.5 * (c.lo + c.hi), half = 0.5 * (c.hi - c.lo);
+    if (!Slab(origin - centre, dir, half, &t_in, &t_out, &axis)) continue;
+    if (t_out <= 1e-9 || t_in > max_t) continue;
+    const Eigen::Vector3d o = c.cam_R_box.transpose() * (origin - c.cam_t_box);
+    const Eigen::Vector3d d = c.cam_R_box.transpose() * dir;
+    if (!Slab(o, d, c.half, &t_in, &t_out, &axis)) continue;
+    if (t_out > 1e-9 && t_in < max_t) return true;
   }
   return false;
 }

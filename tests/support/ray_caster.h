@@ -30,6 +30,7 @@ struct Cuboid {
   Eigen::Vector3d camera_in_box;  // camera centre in the box frame
   Rect camera_rect;               // where rays can hit it
   Rect projector_rect;            // same, seen from the projector
+  Eigen::Vector3d lo, hi;         // axis-aligned bounds in the camera frame
 };
 
 inline constexpr int kNothing = -1;
@@ -58,6 +59,9 @@ class RayCaster {
   // True when the segment from a surface point to the projector crosses a
   // cuboid other than `skip`.
   bool ProjectorBlocked(const Eigen::Vector3d& point, int skip) const;
+  // True when origin + t dir, t in (0, max_t], crosses any cuboid (shadow and
+  // occlusion rays of the colour rendering). The floor never occludes.
+  bool Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double max_t) const;
 
   const Eigen::Vector3d& projector() const { return projector_; }
   const std::vector<Cuboid>& cuboids() const { return cuboids_; }

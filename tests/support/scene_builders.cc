@@ -36,6 +36,15 @@ double RestHeight(const BoxDims& dims, const Eigen::Matrix3d& R) {
 // Keeps the layout and the noise streams apart while staying a function of seed.
 uint32_t NoiseSeed(uint32_t seed) { return seed * 2654435761u + 0x9E3779B9u; }
 
+// The builder's own ranges unless the placement sets them.
+struct CameraRange {
+  double lo, hi, tilt;
+};
+CameraRange Range(const CameraPlacement& p, double lo, double hi, double tilt) {
+  return {p.min_distance_m >= 0 ? p.min_distance_m : lo,
+          p.max_distance_m >= 0 ? p.max_distance_m : hi, p.max_tilt_deg >= 0 ? p.max_tilt_deg : tilt};
+}
+
 void SetRandomCamera(const Eigen::Vector3d& look_at, double dist_lo, double dist_hi,
                      double max_tilt_deg, std::mt19937& rng, Scene* scene) {
   const double distance = Uniform(rng, dist_lo, dist_hi);
@@ -177,17 +186,21 @@ Eigen::Isometry3d DropOnHeap(const BoxDims& dims, const std::vector<Eigen::Isome
 
 }  // namespace
 
-Scene MakeIsolatedScene(const BoxDims& dims, int num_boxes, uint32_t seed) {
+Scene MakeIsolatedScene(const BoxDims& dims, int num_boxes, uint32_t seed,
+                        const CameraPlacement& placement) {
   std::mt19937 rng(seed);
+  const CameraRange range = Range(placement, 0.9, 1.3, 20.0);
   // 6 cm apart: each footprint grows by 3 cm on every side and must not overlap.
   const BoxDims padded{dims.l + 0.06, dims.b + 0.06, dims.h};
   Scene best;
   for (int attempt = 0; attempt < 200; ++attempt) {
     Scene scene;
+    scene.camera = placement.intrinsics;
     scene.noise_seed = NoiseSeed(seed);
     // Move the camera back if the boxes keep failing to fit.
     const double extra = std::min(0.3, 0.01 * attempt);
-    SetRandomCamera(Eigen::Vector3d::Zero(), 0.9 + extra, 1.3 + extra, 20.0, rng, &scene);
+    SetRandomCamera(Eigen::Vector3d::Zero(), range.lo + extra, range.hi + extra, range.tilt, rng,
+                    &scene);
     const Eigen::Isometry3d& world_T_camera = scene.world_T_camera;
     const CameraIntrinsics& cam = scene.camera;
     for (int tries = 0; tries < 300 && static_cast<int>(scene.boxes.size()) < num_boxes; ++tries) {
@@ -213,9 +226,11 @@ Scene MakeIsolatedScene(const BoxDims& dims, int num_boxes, uint32_t seed) {
   return best;
 }
 
-Scene MakeHeapScene(const BoxDims& dims, int num_boxes, uint32_t seed) {
+Scene MakeHeapScene(const BoxDims& dims, int num_boxes, uint32_t seed,
+                    const CameraPlacement& placement) {
   std::mt19937 rng(seed);
   Scene scene;
+  scene.camera = placement.intrinsics;
   scene.noise_seed = NoiseSeed(seed);
   std::vector<Eigen::Isometry3d> placed;
   for (int i = 0; i < num_boxes; ++i) {
@@ -235,7 +250,9 @@ Scene MakeHeapScene(const BoxDims& dims, int num_boxes, uint32_t seed) {
   const Eigen::Vector2d c = HeapCentre(placed);
   double mean_z = 0.0;
   for (const auto& p : placed) mean_z += p.translation().z() / placed.size();
-  SetRandomCamera(Eigen::Vector3d(c.x(), c.y(), mean_z), 1.0, 1.5, 25.0, rng, &scene);
+  const CameraRange range = Range(placement, 1.0, 1.5, 25.0);
+  SetRandomCamera(Eigen::Vector3d(c.x(), c.y(), mean_z), range.lo, range.hi, range.tilt, rng,
+                  &scene);
   return scene;
 }
 
@@ -248,9 +265,17 @@ Scene MakeCellScene(const BoxDims& dims, int num_boxes, uint32_t seed) {
 }
 
 Scene MakePalletScene(const BoxDims& dims, int rows, int cols, int layers, double gap_m,
-                      int removed_top, uint32_t seed) {
+                      int removed_top, uint32_t seed, const CameraPlacement& placement) {
+  return MakeDistractorPalletScene(dims, rows, cols, layers, gap_m, removed_top, 0, seed,
+                                   placement);
+}
+
+Scene MakeDistractorPalletScene(const BoxDims& dims, int rows, int cols, int layers, double gap_m,
+                                int removed_top, int num_distractors, uint32_t seed,
+                                const CameraPlacement& placement) {
   std::mt19937 rng(seed);
   Scene scene;
+  scene.camera = placement.intrinsics;
   scene.noise_seed = NoiseSeed(seed);
   scene.supports = MakeEurPallet(Eigen::Isometry3d::Identity());
 
@@ -263,6 +288,7 @@ Scene MakePalletScene(const BoxDims& dims, int rows, int cols, int layers, doubl
   }
 
   std::vector<Eigen::Isometry3d> placed;
+  std::vector<size_t> top_boxes;  // indices of the top layer's boxes
   for (int layer = 0; layer < layers; ++layer) {
     const double z = kEurPalletHeight + (layer + 0.5) * dims.h;
     for (int r = 0; r < rows; ++r) {
@@ -282,11 +308,29 @@ Scene MakePalletScene(const BoxDims& dims, int rows, int cols, int layers, doubl
         if (!Free(dims, pose, placed)) continue;  // defensive: never interpenetrate
         placed.push_back(pose);
         scene.boxes.push_back({dims, pose, true});
+        if (layer == layers - 1) top_boxes.push_back(scene.boxes.size() - 1);
       }
     }
   }
   const double top = kEurPalletHeight + layers * dims.h;
-  SetRandomCamera(Eigen::Vector3d(0, 0, top), 1.1, 1.5, 20.0, rng, &scene);
+  const CameraRange range = Range(placement, 1.1, 1.5, 20.0);
+  SetRandomCamera(Eigen::Vector3d(0, 0, top), range.lo, range.hi, range.tilt, rng, &scene);
+  // Drawn after the camera, so scenes without distractors keep their streams.
+  if (num_distractors > 0) {
+    std::shuffle(top_boxes.begin(), top_boxes.end(), rng);
+    for (int d = 0; d < num_distractors && d < static_cast<int>(top_boxes.size()); ++d) {
+      SceneBox& box = scene.boxes[top_boxes[d]];
+      const BoxDims other{dims.l * Uniform(rng, 0.55, 0.85), dims.b * Uniform(rng, 0.6, 0.9),
+                          dims.h * Uniform(rng, 0.6, 1.3)};
+      // Pushed against one corner of the cell, resting on the layer below.
+      const double sx = Uniform(rng, 0, 1) < 0.5 ? -1 : 1, sy = Uniform(rng, 0, 1) < 0.5 ? -1 : 1;
+      Eigen::Isometry3d pose = box.world_T_box;
+      pose.translation() += pose.linear() * Eigen::Vector3d(sx * 0.5 * (dims.l - other.l),
+                                                            sy * 0.5 * (dims.b - other.b), 0.0);
+      pose.translation().z() += 0.5 * (other.h - dims.h);
+      box = {other, pose, false};
+    }
+  }
   return scene;
 }
 

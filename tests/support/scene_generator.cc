@@ -8,8 +8,12 @@
 #include <numbers>
 #include <random>
 
+#include "tests/support/color_render.h"
 #include "tests/support/kinect_noise.h"
 #include "tests/support/ray_caster.h"
+#include "tests/support/stereo_noise.h"
+#include "tests/support/surface_texture.h"
+#include "tests/support/tof_noise.h"
 
 namespace cornerpose::testing {
 namespace {
@@ -87,9 +91,21 @@ Eigen::Isometry3d LookAtCamera(const Eigen::Vector3d& look_at_world, double dist
 }
 
 RenderedScene Render(const Scene& scene, const NoiseOptions& noise) {
+  SensorOptions sensor;
+  sensor.kinect = noise;
+  return Render(scene, sensor);
+}
+
+RenderedScene Render(const Scene& scene, const SensorOptions& sensor) {
   const CameraIntrinsics& cam = scene.camera;
   const int width = cam.width, height = cam.height, n = width * height;
-  const RayCaster caster(scene, noise.projector_offset_m);
+  const NoiseOptions& noise = sensor.kinect;
+  // The "projector" is whatever must see a point besides the camera: the
+  // Kinect's IR projector, the stereo pair's right imager; none for ToF.
+  const double offset = sensor.kind == SensorKind::kKinect   ? noise.projector_offset_m
+                        : sensor.kind == SensorKind::kStereo ? sensor.stereo.baseline_m
+                                                             : 0.0;
+  const RayCaster caster(scene, offset);
 
   RenderedScene out;
   out.camera = cam;
@@ -117,9 +133,17 @@ RenderedScene Render(const Scene& scene, const NoiseOptions& noise) {
     out.boxes.push_back(MakeGroundTruth(scene, caster, i, out.instance, out.face));
   }
 
+  const internal::SurfaceTexture texture(scene, caster);
   std::vector<double> depth(n, std::numeric_limits<double>::quiet_NaN());
-  if (noise.enabled) {
-    std::mt19937 rng(scene.noise_seed);
+  std::mt19937 rng(scene.noise_seed);
+  std::vector<uint32_t> infrared;
+  if (sensor.kind == SensorKind::kStereo) {
+    depth = internal::ApplyStereoNoise(caster, texture, cam, sensor.stereo, nominal, rng,
+                                       &out.stats);
+  } else if (sensor.kind == SensorKind::kTimeOfFlight) {
+    depth = internal::ApplyTofNoise(caster, texture, cam, sensor.tof, nominal, rng, &out.stats,
+                                    sensor.color.enabled ? &infrared : nullptr);
+  } else if (noise.enabled) {
     depth = internal::ApplyKinectNoise(caster, cam, noise, nominal, rng, &out.stats);
   } else {
     for (int i = 0; i < n; ++i) {
@@ -141,6 +165,13 @@ RenderedScene Render(const Scene& scene, const NoiseOptions& noise) {
     const double z = depth[i];
     out.cloud.xyz[i] = std::isnan(z) ? Eigen::Vector3f(nan, nan, nan)
                                      : (z * caster.Ray(i % width, i / width)).cast<float>();
+  }
+  if (sensor.color.enabled) {
+    // Time of flight sees its own infrared light; the others a colour camera.
+    out.cloud.rgb = sensor.kind == SensorKind::kTimeOfFlight
+                        ? std::move(infrared)
+                        : internal::RenderColor(scene, caster, texture, nominal, sensor.color,
+                                                scene.noise_seed ^ 0xC0105EEDu);
   }
   return out;
 }

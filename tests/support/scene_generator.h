@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/perception/types.h"
+#include "tests/support/sensor_options.h"
 
 namespace cornerpose::testing {
 
@@ -110,11 +111,16 @@ struct RenderStats {
   int shadow = 0;
   int grazing = 0;
   int flying = 0;  // valid but moved to a mixed depth
-  int dropout = 0;
+  int dropout = 0;  // random and speckle holes, blobs, low signal (tof)
+  int filled = 0;   // valid, depth taken from the sides of a thin gap or hole (stereo)
+  int multipath = 0;  // valid, biased by more than 1 mm by multipath (tof)
 };
 
 struct RenderedScene {
-  PointCloud cloud;  // organized, camera frame, NaN where invalid
+  // Organized, camera frame, NaN where invalid. With colour rendering on,
+  // cloud.rgb holds the registered image (0x00RRGGBB, every pixel, valid
+  // depth or not; grey infrared intensity for time of flight).
+  PointCloud cloud;
   CameraIntrinsics camera;
   // Per pixel, from the noise-free nominal rays: 0 floor/nothing,
   // k = boxes[k-1], 255 support.
@@ -128,16 +134,49 @@ struct RenderedScene {
 
 RenderedScene Render(const Scene& scene, const NoiseOptions& noise = {});
 
+// A sensor model and the colour image. The Kinect model with the same
+// NoiseOptions gives exactly the depth of Render(scene, kinect); colour
+// draws on its own random stream, so turning it on changes no depth.
+struct SensorOptions {
+  SensorKind kind = SensorKind::kKinect;
+  NoiseOptions kinect;
+  StereoOptions stereo;
+  TofOptions tof;
+  ColorOptions color;
+
+  absl::Status Validate() const;
+};
+RenderedScene Render(const Scene& scene, const SensorOptions& sensor);
+
+// Where the scene builders put the camera: its intrinsics (they become
+// Scene::camera) and the range of its distance to the scene's look-at point
+// and of its tilt. A distance or tilt below 0 keeps each builder's own
+// default (the Kinect dev-set ranges below), and the default placement
+// gives the same scenes as the builders without one.
+struct CameraPlacement {
+  CameraIntrinsics intrinsics;
+  double min_distance_m = -1.0;
+  double max_distance_m = -1.0;
+  double max_tilt_deg = -1.0;
+};
+// A placement fit for a sensor's working range: kinect keeps the defaults;
+// stereo 1.3-2.0 m (look-at point to camera), tilt 0-20 deg; tof 1.0-1.8 m,
+// tilt 0-20 deg.
+CameraPlacement SensorPlacement(SensorKind kind, const CameraIntrinsics& intrinsics);
+
 // Scene builders. The seed fixes the layout, the camera and the noise.
 
 // num_boxes boxes lying flat (h vertical) on the floor, random yaw, at least
 // 6 cm apart, all fully in view; camera 0.9-1.3 m away, tilt 0-20 deg.
-Scene MakeIsolatedScene(const BoxDims& dims, int num_boxes, uint32_t seed);
+Scene MakeIsolatedScene(const BoxDims& dims, int num_boxes, uint32_t seed,
+                        const CameraPlacement& placement = {});
 
 // A heap of touching, stacked and tilted boxes on the floor: boxes slide in
 // until they touch the heap, or are dropped onto it (tilted up to 30 deg,
 // lowest centre kept). No two boxes interpenetrate.
-Scene MakeHeapScene(const BoxDims& dims, int num_boxes, uint32_t seed);
+// Camera 1.0-1.5 m, tilt 0-25 deg.
+Scene MakeHeapScene(const BoxDims& dims, int num_boxes, uint32_t seed,
+                    const CameraPlacement& placement = {});
 
 // The demo cell's view: a heap (as MakeHeapScene) around the world origin
 // seen by a camera fixed kCellCameraHeight straight above the origin
@@ -148,9 +187,18 @@ Scene MakeCellScene(const BoxDims& dims, int num_boxes, uint32_t seed);
 
 // A rows x cols x layers grid on a EUR pallet, l along the pallet length,
 // gap_m between boxes, +-2 mm / +-0.6 deg jitter; removed_top boxes of the top
-// layer are taken away row by row from a corner.
+// layer are taken away row by row from a corner. Camera 1.1-1.5 m above the
+// top layer, tilt 0-20 deg.
 Scene MakePalletScene(const BoxDims& dims, int rows, int cols, int layers, double gap_m,
-                      int removed_top, uint32_t seed);
+                      int removed_top, uint32_t seed, const CameraPlacement& placement = {});
+
+// As MakePalletScene, and then num_distractors of the top layer's remaining
+// boxes are replaced by boxes of another size (target false: 55-85 % of the
+// length, 60-90 % of the width, 60-130 % of the height), each pushed against
+// a side of its cell. With 0 distractors this is MakePalletScene.
+Scene MakeDistractorPalletScene(const BoxDims& dims, int rows, int cols, int layers, double gap_m,
+                                int removed_top, int num_distractors, uint32_t seed,
+                                const CameraPlacement& placement = {});
 
 // Support structures. The pallet frame sits at the centre of its footprint on
 // the ground, x along the 1.2 m side; its deck is kEurPalletHeight high.
