@@ -1,7 +1,6 @@
 #include "common/io/cloud_io.h"
 
 #include <pcl/PCLPointCloud2.h>
-#include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 
 #include <algorithm>
@@ -11,6 +10,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
 
@@ -21,11 +21,14 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
 #include "common/io/cloud_header_check.h"
+#include "common/io/pcd_reader.h"
 
 namespace cornerpose {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+// The header check bounds the points at 4 GiB; the header and slack on top.
+constexpr uint64_t kMaxPcdFileBytes = (uint64_t{1} << 32) + (uint64_t{1} << 24);
 
 // Byte size of a PCLPointField datatype, 0 when unsupported.
 size_t FieldBytes(uint8_t datatype) {
@@ -136,18 +139,25 @@ absl::StatusOr<PointCloud> FromBlob(const pcl::PCLPointCloud2& blob, const std::
   return cloud;
 }
 
+// Our own reader (pcd_reader.h), not PCL's: PCL's trusts the file's bytes.
 absl::StatusOr<PointCloud> LoadPcd(const std::string& path) {
-  if (absl::Status s = CheckPcdHeader(path); !s.ok()) return s;
-  pcl::PCLPointCloud2 blob;
-  Eigen::Vector4f origin;
-  Eigen::Quaternionf orientation;
-  int version = 0;
-  pcl::PCDReader reader;
-  if (reader.read(path, blob, origin, orientation, version, 0) < 0) {
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  if (ec) return absl::InvalidArgumentError(absl::StrCat(path, ": ", ec.message()));
+  if (size > kMaxPcdFileBytes) {
     return absl::InvalidArgumentError(
-        absl::StrCat(path, ": PCL could not read this PCD file (corrupt or truncated data)"));
+        absl::StrCat(path, ": ", size, " bytes is more than a PCD file may hold"));
   }
-  return FromBlob(blob, path);
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes(static_cast<size_t>(size), '\0');
+  if (!in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()))) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": cannot read the file"));
+  }
+  absl::StatusOr<PointCloud> cloud = ReadPcd(bytes);
+  if (!cloud.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": ", cloud.status().message()));
+  }
+  return cloud;
 }
 
 absl::StatusOr<PointCloud> LoadPly(const std::string& path) {
