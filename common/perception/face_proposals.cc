@@ -88,10 +88,11 @@ std::vector<FaceTiling> TilingsOf(double width_m, double height_m, const BoxDims
     for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {
       FaceTiling t{n, su, sv, FaceCount(width_m, dims[su], o), FaceCount(height_m, dims[sv], o)};
       if (t.count_u == 0 || t.count_v == 0 || t.tiles() > o.max_tiles) continue;
-      // Equal sides give the same tiling twice (the box's symmetries).
+      // Equal sides give the same tiling twice (the box's symmetries). The
+      // lambda takes t's copies: clang 14 cannot capture structured bindings.
       const bool repeat = std::any_of(out.begin(), out.end(), [&](const FaceTiling& q) {
-        return std::abs(dims[q.axis_u] - dims[su]) < 1e-4 &&
-               std::abs(dims[q.axis_v] - dims[sv]) < 1e-4 &&
+        return std::abs(dims[q.axis_u] - dims[t.axis_u]) < 1e-4 &&
+               std::abs(dims[q.axis_v] - dims[t.axis_v]) < 1e-4 &&
                std::abs(dims[q.normal_axis] - dims[n]) < 1e-4;
       });
       if (!repeat) out.push_back(t);
