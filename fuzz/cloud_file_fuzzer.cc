@@ -1,6 +1,6 @@
-// PCD and PLY files through LoadPointCloud (common/io): the header checks,
-// PCL's readers and the copy out of PCL's blob. Built twice, with
-// CORNERPOSE_FUZZ_EXTENSION ".pcd" and ".ply". Any status is fine; a crash,
+// Cloud files through LoadPointCloud (common/io), by CORNERPOSE_FUZZ_EXTENSION:
+// ply_fuzzer (".ply": the header check, PCL's PLY reader, the copy out of
+// PCL's blob); pcd_fuzzer.cc feeds ReadPcd directly. Any status is fine; a crash,
 // a sanitizer report, a hang or a cloud that breaks its own invariants is a
 // finding.
 #include <cstddef>

@@ -32,6 +32,9 @@ constexpr char kHelp[] =
     "                       carton_sq, carton_flat\n"
     "  --intrinsics K       fx,fy,cx,cy or width,height,fx,fy,cx,cy: the camera of a\n"
     "                       depth image, or of an unorganized cloud (default Kinect VGA)\n"
+    "  --color FILE         colour PNG registered to the organized cloud or depth image\n"
+    "                       (seam cues; the --png is drawn over it). Default: the PCD's\n"
+    "                       rgb/rgba field, or NAME.color.png beside a depth NAME.png\n"
     "outputs (any number):\n"
     "  --json OUT           boxes, edges, corners and per-stage timings\n"
     "  --ply OUT            coloured cloud: grey points, red edge points, segments,\n"
@@ -50,6 +53,10 @@ constexpr char kHelp[] =
     "                       the paper's formula exactly, for clouds not taken by a camera\n"
     "                       at the origin\n"
     "  --threads N          worker threads (2)\n"
+    "  --faces BOOL         face-first proposals from planar patches (true); false is\n"
+    "                       the corner-only detector\n"
+    "  --size_tolerance M   how far a box may be off its nominal size and still be it\n"
+    "                       (unset: each stage's own tolerance, 1-2.5 cm)\n"
     "  --kdtree             unorganized clouds: score edges over a k-d tree (the\n"
     "                       paper's way) instead of projecting onto the camera grid\n"
     "  --quiet              print nothing but errors\n";
@@ -77,9 +84,16 @@ absl::Status Run(const CommandArgs& args) {
                          args.SetDouble("meet_distance", &options.clubbing.meet_distance_m),
                          args.SetInt("threads", &options.num_threads),
                          args.SetInt("coarse_step", &options.edge_points.coarse_step),
-                         args.SetBool("denoise", &options.edge_points.denoise)}) {
+                         args.SetBool("denoise", &options.edge_points.denoise),
+                         args.SetBool("faces", &options.face_proposals)}) {
     if (!s.ok()) return s;
   }
+  if (get("size_tolerance")) {
+    double t = 0.0;
+    if (absl::Status s = args.SetDouble("size_tolerance", &t); !s.ok()) return s;
+    options.size_tolerance_m = t;
+  }
+  if (auto c = get("color")) load.color_path = *c;
   options.project_unorganized = !args.Has("kdtree");
   // r_s is also the gap at which a segment ends (Algorithm 1).
   SetEdgeRadius(options.edge_points.radius_m, &options);
@@ -89,7 +103,14 @@ absl::Status Run(const CommandArgs& args) {
   absl::StatusOr<Detection> det = DetectBoxes(*cloud, options);
   if (!det.ok()) return det.status();
 
-  if (!args.Has("quiet")) PrintDetection(*get("cloud"), cloud->size(), *det);
+  if (!args.Has("quiet")) {
+    PrintDetection(*get("cloud"), cloud->size(), *det);
+    for (const DeclinedCandidate& d : det->declined) {
+      const Eigen::Vector3d t = d.camera_T_box.translation();
+      std::printf("  declined: support %.2f  centre (%.3f, %.3f, %.3f) m  %s\n", d.score, t.x(),
+                  t.y(), t.z(), d.reason.c_str());
+    }
+  }
   if (auto p = get("json")) {
     if (absl::Status s = WriteDetectionJson(*p, *det, *box); !s.ok()) return s;
   }
@@ -135,7 +156,8 @@ int RunDetect(const std::vector<std::string>& argv) {
   absl::StatusOr<CommandArgs> args = ParseCommandArgs(
       argv,
       {"cloud", "box", "intrinsics", "json", "ply", "png", "edges", "radius", "threshold",
-       "samples", "ransac_threshold", "meet_distance", "threads", "coarse_step", "denoise"},
+       "samples", "ransac_threshold", "meet_distance", "threads", "coarse_step", "denoise",
+       "color", "faces", "size_tolerance"},
       {"quiet", "kdtree"});
   if (!args.ok()) {
     std::fprintf(stderr, "cornerpose detect: %s\n\n%s",

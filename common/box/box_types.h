@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -43,6 +44,11 @@ struct DetectedBox {
   Eigen::Vector3d grasp_normal_camera = Eigen::Vector3d::Zero();  // its outward normal
   std::vector<int> segments;  // edge segments that support the box
   int num_corners = 0;        // corners used for its pose
+  // The grasp face's size as measured between two ends (free sides or
+  // seams) along its two in-plane box axes, (n+1) % 3 and (n+2) % 3 for the
+  // face's normal axis n; 0 where a side was not measured. Metres.
+  std::array<double, 2> measured_extent_m{0.0, 0.0};
+  bool from_face = false;  // proposed by a planar patch (else by corners or a neighbour)
 };
 
 }  // namespace cornerpose

@@ -1,7 +1,6 @@
 #include "common/io/cloud_io.h"
 
 #include <pcl/PCLPointCloud2.h>
-#include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 
 #include <algorithm>
@@ -11,6 +10,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
 
@@ -21,11 +21,14 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
 #include "common/io/cloud_header_check.h"
+#include "common/io/pcd_reader.h"
 
 namespace cornerpose {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+// The header check bounds the points at 4 GiB; the header and slack on top.
+constexpr uint64_t kMaxPcdFileBytes = (uint64_t{1} << 32) + (uint64_t{1} << 24);
 
 // Byte size of a PCLPointField datatype, 0 when unsupported.
 size_t FieldBytes(uint8_t datatype) {
@@ -102,6 +105,16 @@ absl::StatusOr<PointCloud> FromBlob(const pcl::PCLPointCloud2& blob, const std::
                                                    " points do not fit in ", blob.data.size(),
                                                    " bytes of data"));
   }
+  // Colour: a 4-byte rgb or rgba field, U (uint32) or F (the same bits in a
+  // float), packed 0xAARRGGBB; the alpha byte is dropped.
+  const pcl::PCLPointField* colour = nullptr;
+  for (const pcl::PCLPointField& f : blob.fields) {
+    if ((f.name == "rgb" || f.name == "rgba") && FieldBytes(f.datatype) == 4 &&
+        f.datatype != pcl::PCLPointField::INT8 && size_t{f.offset} + 4 <= blob.point_step) {
+      colour = &f;
+      break;
+    }
+  }
   PointCloud cloud;
   if (n == 0) return cloud;
   cloud.width = static_cast<int>(blob.width);
@@ -115,21 +128,36 @@ absl::StatusOr<PointCloud> FromBlob(const pcl::PCLPointCloud2& blob, const std::
     }
     cloud.xyz[i] = p.allFinite() ? p : Eigen::Vector3f::Constant(kNaN);
   }
+  if (colour != nullptr) {
+    cloud.rgb.resize(cloud.xyz.size());
+    for (size_t i = 0; i < cloud.rgb.size(); ++i) {
+      uint32_t packed;
+      std::memcpy(&packed, blob.data.data() + i * blob.point_step + colour->offset, 4);
+      cloud.rgb[i] = packed & 0x00FFFFFFu;
+    }
+  }
   return cloud;
 }
 
+// Our own reader (pcd_reader.h), not PCL's: PCL's trusts the file's bytes.
 absl::StatusOr<PointCloud> LoadPcd(const std::string& path) {
-  if (absl::Status s = CheckPcdHeader(path); !s.ok()) return s;
-  pcl::PCLPointCloud2 blob;
-  Eigen::Vector4f origin;
-  Eigen::Quaternionf orientation;
-  int version = 0;
-  pcl::PCDReader reader;
-  if (reader.read(path, blob, origin, orientation, version, 0) < 0) {
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  if (ec) return absl::InvalidArgumentError(absl::StrCat(path, ": ", ec.message()));
+  if (size > kMaxPcdFileBytes) {
     return absl::InvalidArgumentError(
-        absl::StrCat(path, ": PCL could not read this PCD file (corrupt or truncated data)"));
+        absl::StrCat(path, ": ", size, " bytes is more than a PCD file may hold"));
   }
-  return FromBlob(blob, path);
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes(static_cast<size_t>(size), '\0');
+  if (!in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()))) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": cannot read the file"));
+  }
+  absl::StatusOr<PointCloud> cloud = ReadPcd(bytes);
+  if (!cloud.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": ", cloud.status().message()));
+  }
+  return cloud;
 }
 
 absl::StatusOr<PointCloud> LoadPly(const std::string& path) {
@@ -167,7 +195,19 @@ absl::StatusOr<PointCloud> LoadDepthImage(const std::string& path, const LoadOpt
                                                    " but the intrinsics are for ", camera.width,
                                                    " x ", camera.height));
   }
-  return DepthToCloud(*depth, camera, options.depth_scale_m);
+  PointCloud cloud = DepthToCloud(*depth, camera, options.depth_scale_m);
+  // A colour image registered to the depth image: NAME.color.png beside
+  // NAME.png (the recorded-frame convention), used when it is there.
+  if (!options.color_path) {
+    const std::filesystem::path p(path);
+    const std::filesystem::path beside =
+        p.parent_path() / (p.stem().string() + ".color.png");
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(beside, ec)) {
+      if (absl::Status s = AttachColor(beside.string(), &cloud); !s.ok()) return s;
+    }
+  }
+  return cloud;
 }
 
 struct FileCloser {
@@ -176,9 +216,41 @@ struct FileCloser {
   }
 };
 
+absl::StatusOr<PointCloud> LoadCloudFile(const std::string& path, const LoadOptions& options);
+
 }  // namespace
 
 absl::StatusOr<PointCloud> LoadPointCloud(const std::string& path, const LoadOptions& options) {
+  absl::StatusOr<PointCloud> cloud = LoadCloudFile(path, options);
+  if (!cloud.ok() || !options.color_path) return cloud;
+  if (absl::Status s = AttachColor(*options.color_path, &*cloud); !s.ok()) return s;
+  return cloud;
+}
+
+absl::Status AttachColor(const std::string& path, PointCloud* cloud) {
+  if (!cloud->organized()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(path, ": a colour image needs an organized cloud to register to"));
+  }
+  int width = 0, height = 0;
+  absl::StatusOr<std::vector<uint8_t>> rgb = ReadRgbPng(path, &width, &height);
+  if (!rgb.ok()) return rgb.status();
+  if (width != cloud->width || height != cloud->height) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": colour image is ", width, " x ", height,
+                                                   " but the cloud is ", cloud->width, " x ",
+                                                   cloud->height));
+  }
+  cloud->rgb.resize(cloud->xyz.size());
+  for (size_t i = 0; i < cloud->rgb.size(); ++i) {
+    const uint8_t* c = rgb->data() + 3 * i;
+    cloud->rgb[i] = (uint32_t{c[0]} << 16) | (uint32_t{c[1]} << 8) | c[2];
+  }
+  return absl::OkStatus();
+}
+
+namespace {
+
+absl::StatusOr<PointCloud> LoadCloudFile(const std::string& path, const LoadOptions& options) {
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
   if (!std::filesystem::exists(status)) {
@@ -203,6 +275,8 @@ absl::StatusOr<PointCloud> LoadPointCloud(const std::string& path, const LoadOpt
                                                  "' (expected .pcd, .ply or a 16-bit depth .png)"));
 }
 
+}  // namespace
+
 PointCloud DepthToCloud(const std::vector<uint16_t>& depth, const CameraIntrinsics& camera,
                         double depth_scale_m) {
   PointCloud cloud;
@@ -216,7 +290,7 @@ PointCloud DepthToCloud(const std::vector<uint16_t>& depth, const CameraIntrinsi
   for (int v = 0; v < camera.height; ++v) {
     for (int u = 0; u < camera.width; ++u) {
       const size_t i = static_cast<size_t>(v) * camera.width + u;
-      if (depth[i] == 0) {
+      if (depth[i] == 0 || depth[i] == 65535) {  // no return (65535 on some stereo cameras)
         cloud.xyz[i] = Eigen::Vector3f::Constant(kNaN);
         continue;
       }

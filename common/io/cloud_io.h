@@ -20,12 +20,19 @@ struct LoadOptions {
   std::optional<CameraIntrinsics> intrinsics;
   // Metres per depth unit of a depth image (millimetres by default).
   double depth_scale_m = 0.001;
+  // A colour (or grey) PNG registered to an organized cloud, same width and
+  // height: becomes PointCloud::rgb. Unset: a depth image NAME.png takes
+  // NAME.color.png from beside it when there is one; a PCD keeps its own
+  // rgb/rgba field.
+  std::optional<std::string> color_path;
 };
 
 // Loads a cloud, by extension (case-insensitive):
 //   .pcd  ascii, binary or binary_compressed, any field order and extra fields;
 //   .ply  ascii or binary, organized when it has a range grid;
 //   .png  16-bit depth image, 0 = no return, converted with options.intrinsics.
+// Colour comes from a PCD's rgb/rgba field (U or F, 0xAARRGGBB), from
+// options.color_path, or from NAME.color.png beside a depth image NAME.png.
 // Organized clouds keep their width x height and NaN points. A point with any
 // non-finite coordinate becomes NaN in all three.
 // NOT_FOUND for a missing file; INVALID_ARGUMENT for anything that is not a
@@ -33,9 +40,14 @@ struct LoadOptions {
 // missing or mismatched intrinsics, unknown extension).
 absl::StatusOr<PointCloud> LoadPointCloud(const std::string& path, const LoadOptions& options = {});
 
+// Reads a colour PNG (8/16-bit, RGB, grey or palette) into cloud->rgb; the
+// image must have the organized cloud's width and height (INVALID_ARGUMENT
+// otherwise, NOT_FOUND when missing).
+absl::Status AttachColor(const std::string& path, PointCloud* cloud);
+
 // Back-projects a depth image (row-major, camera.width x camera.height) into
 // an organized cloud: x = (u - cx) z / fx, y = (v - cy) z / fy, z = d *
-// depth_scale_m; d = 0 gives NaN. Returns an empty cloud when depth.size()
+// depth_scale_m; d = 0 and d = 65535 (no return on some stereo cameras) give NaN. Returns an empty cloud when depth.size()
 // does not match the intrinsics.
 PointCloud DepthToCloud(const std::vector<uint16_t>& depth, const CameraIntrinsics& camera,
                         double depth_scale_m);

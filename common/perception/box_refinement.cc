@@ -251,6 +251,24 @@ SideMeasure MeasureSide(const std::vector<FacePoint>& pts, const std::vector<Fac
   return m;
 }
 
+// A continuing side becomes a seam when the colour image shows a straight
+// line along all of it within seam_search_m (plus the colour search) of the
+// hypothesised side.
+void ColourSeamSide(const DepthImage& depth, const FaceFrame& f, bool along_a, double sign,
+                    const RefinementOptions& o, SideMeasure* m) {
+  if (m->kind != SideKind::kContinues) return;
+  const Eigen::Vector3d across = sign * (along_a ? f.a : f.b);
+  const Eigen::Vector3d along = along_a ? f.b : f.a;
+  const double half = along_a ? f.half_a : f.half_b;
+  const double half_other = along_a ? f.half_b : f.half_a;
+  const Eigen::Vector3d mid = f.c + half * across;
+  const SeamCue cue = ColourSeamAlong(depth, mid - half_other * along, mid + half_other * along,
+                                      across, o.colour_seams);
+  if (!cue.seam || std::abs(cue.offset_m) > o.seam_search_m + 0.004) return;
+  m->kind = SideKind::kSeam;
+  m->position = half + cue.offset_m;
+}
+
 // True when, past a side, the first surface after a run of missing returns
 // lies in front of the face's plane: the gap is the shadow of something
 // standing over the face, which may go on underneath it, so the side is not
@@ -340,6 +358,7 @@ int TileCount(double extent, double tile, double tolerance, const RefinementOpti
 }  // namespace
 
 absl::Status RefinementOptions::Validate() const {
+  if (absl::Status s = colour_seams.Validate(); !s.ok()) return s;
   for (absl::Status s : {
            CheckPositive("refinement.plane_tolerance_m", plane_tolerance_m, 0.2),
            CheckRange("refinement.side_band_m", side_band_m, 0.005, 0.2),
@@ -395,14 +414,21 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     result.face_points = n;
 
     // Sides: +a, -a, +b, -b.
-    const SideMeasure pa =
-        MeasureSide(pts, front, grid, true, 1.0, f.half_a, f.half_b, pixel_m, options);
-    const SideMeasure ma =
+    SideMeasure pa = MeasureSide(pts, front, grid, true, 1.0, f.half_a, f.half_b, pixel_m, options);
+    SideMeasure ma =
         MeasureSide(pts, front, grid, true, -1.0, f.half_a, f.half_b, pixel_m, options);
-    const SideMeasure pb =
+    SideMeasure pb =
         MeasureSide(pts, front, grid, false, 1.0, f.half_b, f.half_a, pixel_m, options);
-    const SideMeasure mb =
+    SideMeasure mb =
         MeasureSide(pts, front, grid, false, -1.0, f.half_b, f.half_a, pixel_m, options);
+    // Where the depth shows the face running on with no seam, a straight
+    // line in the colour image along the whole side is one.
+    if (depth.has_grey()) {
+      ColourSeamSide(depth, f, true, 1.0, options, &pa);
+      ColourSeamSide(depth, f, true, -1.0, options, &ma);
+      ColourSeamSide(depth, f, false, 1.0, options, &pb);
+      ColourSeamSide(depth, f, false, -1.0, options, &mb);
+    }
     result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
     result.free_sides = 0;
     for (SideKind k : result.sides) result.free_sides += k == SideKind::kFree;

@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "common/perception/camera_model.h"
+#include "common/perception/seam_cues.h"
 #include "common/perception/types.h"
 
 namespace cornerpose {
@@ -43,6 +44,9 @@ struct RefinementOptions {
   double tile_gap_m = 0.002;
   double tile_tolerance_m = 0.01;
   double max_tile_march_m = 2.5;
+  // With a registered colour image: a side where the face runs on is a seam
+  // when a straight image line runs along all of it (seam_cues.h).
+  SeamCueOptions colour_seams;
   // Iterations of measure-and-update. Count.
   int iterations = 2;
   // Largest correction accepted, beyond which the hypothesis is not this

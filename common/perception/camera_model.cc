@@ -73,6 +73,13 @@ DepthImage MakeDepthImage(const PointCloud& cloud, const CameraIntrinsics& k) {
     for (size_t i = 0; i < cloud.size(); ++i) {
       image.z[i] = PointCloud::IsValid(cloud.xyz[i]) ? cloud.xyz[i].z() : nan;
     }
+    if (cloud.has_color()) {
+      image.grey.resize(cloud.size());
+      for (size_t i = 0; i < cloud.size(); ++i) {
+        const uint32_t c = cloud.rgb[i];
+        image.grey[i] = static_cast<float>(((c >> 16) & 0xFF) + ((c >> 8) & 0xFF) + (c & 0xFF)) / 3.0f;
+      }
+    }
     return image;
   }
   image.z.assign(static_cast<size_t>(k.width) * k.height, nan);
@@ -94,13 +101,18 @@ PointCloud OrganizeByProjection(const PointCloud& cloud, const CameraIntrinsics&
   out.height = k.height;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   out.xyz.assign(static_cast<size_t>(k.width) * k.height, Eigen::Vector3f(nan, nan, nan));
-  for (const Eigen::Vector3f& p : cloud.xyz) {
+  if (cloud.has_color()) out.rgb.assign(out.xyz.size(), 0);
+  for (size_t i = 0; i < cloud.xyz.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.xyz[i];
     if (!PointCloud::IsValid(p) || p.z() <= 0.0f) continue;
     const Eigen::Vector2d px = Project(k, p.cast<double>());
     const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
     if (u < 0 || v < 0 || u >= k.width || v >= k.height) continue;
     Eigen::Vector3f& slot = out.xyz[static_cast<size_t>(v) * k.width + u];
-    if (!PointCloud::IsValid(slot) || p.z() < slot.z()) slot = p;
+    if (!PointCloud::IsValid(slot) || p.z() < slot.z()) {
+      slot = p;
+      if (cloud.has_color()) out.rgb[static_cast<size_t>(v) * k.width + u] = cloud.rgb[i];
+    }
   }
   return out;
 }

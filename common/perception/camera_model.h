@@ -42,6 +42,11 @@ std::optional<PixelRect> ProjectedRect(const CameraIntrinsics& k,
 struct DepthImage {
   CameraIntrinsics camera;
   std::vector<float> z;  // metres, row-major
+  // Brightness of the registered colour image, 0-255 per pixel, row-major;
+  // empty when the frame has no colour (see PointCloud::rgb).
+  std::vector<float> grey;
+  bool has_grey() const { return !grey.empty(); }
+  float grey_at(int u, int v) const { return grey[static_cast<size_t>(v) * camera.width + u]; }
   float at(int u, int v) const { return z[static_cast<size_t>(v) * camera.width + u]; }
   bool inside(int u, int v) const {
     return u >= 0 && v >= 0 && u < camera.width && v < camera.height;

@@ -44,7 +44,67 @@ const PointCloud& SanitizeCloud(const PointCloud& cloud, PointCloud* storage) {
   return *storage;
 }
 
+// Median depth of the valid points (every 7th), 0 when none.
+double MedianDepth(const std::vector<float>& z) {
+  std::vector<float> valid;
+  for (size_t i = 0; i < z.size(); i += 7) {
+    if (std::isfinite(z[i]) && z[i] > 0.0f) valid.push_back(z[i]);
+  }
+  if (valid.empty()) return 0.0;
+  std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
+  return valid[valid.size() / 2];
+}
+
+void ApplySizeTolerance(double t, DetectorOptions* o) {
+  o->faces.size_tolerance_m = t;
+  o->refinement.tile_tolerance_m = 2.0 * t / 3.0;
+  o->pose.length_tolerance_m = t + 0.01;
+  o->acceptance.extent_tolerance_m = t + 0.01;
+}
+
+// The strongest declined hypotheses: none that overlaps a returned box (a
+// variant of it) or a stronger declined one.
+std::vector<DeclinedCandidate> StrongestDeclined(std::vector<DeclinedCandidate> all,
+                                                 const std::vector<DetectedBox>& boxes,
+                                                 const DetectorOptions& o) {
+  std::stable_sort(all.begin(), all.end(), [](const DeclinedCandidate& a, const DeclinedCandidate& b) {
+    return a.score > b.score;
+  });
+  std::vector<DeclinedCandidate> out;
+  for (DeclinedCandidate& d : all) {
+    if (static_cast<int>(out.size()) >= o.max_declined) break;
+    auto overlaps = [&](const Eigen::Isometry3d& pose) {
+      return internal::BoxesOverlap(pose, d.camera_T_box, o.box, o.acceptance.overlap_margin_m);
+    };
+    if (std::any_of(boxes.begin(), boxes.end(),
+                    [&](const DetectedBox& b) { return overlaps(b.camera_T_box); }) ||
+        std::any_of(out.begin(), out.end(),
+                    [&](const DeclinedCandidate& c) { return overlaps(c.camera_T_box); })) {
+      continue;
+    }
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
 }  // namespace
+
+void DeriveGeometryParameters(double z, double focal_px, DetectorOptions* o) {
+  const DetectorOptions defaults;
+  const double smallest = std::min({o->box.l, o->box.b, o->box.h});
+  double r = std::max(0.02, z > 0.0 && focal_px > 0.0 ? 6.0 * z / focal_px : 0.0);
+  r = std::min(r, 0.35 * smallest);
+  if (o->edge_points.radius_m == defaults.edge_points.radius_m) {
+    o->edge_points.radius_m = r;
+    if (o->segments.gap_m == defaults.segments.gap_m) o->segments.gap_m = r;
+  }
+  if (o->segments.ransac_threshold_m == defaults.segments.ransac_threshold_m) {
+    o->segments.ransac_threshold_m = r / 2.0;
+  }
+  if (o->clubbing.meet_distance_m == defaults.clubbing.meet_distance_m) {
+    o->clubbing.meet_distance_m = r / 2.0;
+  }
+}
 
 absl::Status AcceptanceOptions::Validate() const {
   for (absl::Status s : {
@@ -68,8 +128,16 @@ absl::Status DetectorOptions::Validate() const {
   if (absl::Status s = box.Validate(); !s.ok()) return s;
   for (absl::Status s :
        {edge_points.Validate(), segments.Validate(), clubbing.Validate(), pose.Validate(),
-        refinement.Validate(), evidence.Validate(), acceptance.Validate()}) {
+        refinement.Validate(), evidence.Validate(), acceptance.Validate(), faces.Validate()}) {
     if (!s.ok()) return s;
+  }
+  if (size_tolerance_m && !(*size_tolerance_m > 0.0 && *size_tolerance_m <= 0.1)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("size_tolerance_m=", *size_tolerance_m, " is outside (0, 0.1]"));
+  }
+  if (max_declined < 0 || max_declined > 1000) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_declined=", max_declined, " is outside [0, 1000]"));
   }
   if (camera) {
     if (absl::Status s = camera->Validate(); !s.ok()) return s;
@@ -136,6 +204,10 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   }
   const PointCloud& work = project ? projected : cloud;
   const DepthImage depth = MakeDepthImage(work, camera);
+  if (options.parameters_from_geometry) {
+    DeriveGeometryParameters(MedianDepth(depth.z), camera.fx, &options);
+  }
+  if (options.size_tolerance_m) ApplySizeTolerance(*options.size_tolerance_m, &options);
   det.timings.preprocess_ms = MsSince(t_start);
 
   Clock::time_point t0 = Clock::now();
@@ -168,6 +240,7 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
     group_corners[group_of[c.segment_a]].push_back(c.position.cast<double>());
   }
 
+  std::vector<DeclinedCandidate> declined;
   internal::HypothesisJudge judge(depth, options);
   for (const Corner& c : det.corners) {
     const EdgeSegment& sa = det.segments[c.segment_a];
@@ -187,35 +260,53 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   // Best first; a box overlapping an accepted one is the same box or a
   // contradiction, and is dropped. Each accepted box proposes its
   // neighbours, which are judged the same way and may propose theirs.
-  std::vector<internal::Candidate> pending = judge.Evaluate(options.num_threads);
-  while (!pending.empty()) {
-    std::stable_sort(pending.begin(), pending.end(),
-                     [](const internal::Candidate& a, const internal::Candidate& b) {
-                       return a.box.score > b.box.score;
-                     });
-    for (internal::Candidate& c : pending) {
-      bool clash = false;
-      for (const DetectedBox& kept : det.boxes) {
-        if (internal::BoxesOverlap(kept.camera_T_box, c.box.camera_T_box, options.box,
-                                   options.acceptance.overlap_margin_m)) {
-          clash = true;
-          break;
+  auto overlaps_kept = [&](const Eigen::Isometry3d& pose) {
+    return std::any_of(det.boxes.begin(), det.boxes.end(), [&](const DetectedBox& kept) {
+      return internal::BoxesOverlap(kept.camera_T_box, pose, options.box,
+                                    options.acceptance.overlap_margin_m);
+    });
+  };
+  auto accept_all = [&] {
+    std::vector<internal::Candidate> pending = judge.Evaluate(options.num_threads);
+    while (!pending.empty()) {
+      std::stable_sort(pending.begin(), pending.end(),
+                       [](const internal::Candidate& a, const internal::Candidate& b) {
+                         return a.box.score > b.box.score;
+                       });
+      for (internal::Candidate& c : pending) {
+        if (overlaps_kept(c.box.camera_T_box)) continue;
+        det.boxes.push_back(c.box);
+        if (options.propagate_to_neighbours) {
+          for (const Eigen::Isometry3d& pose :
+               NeighbourHypotheses(c.box, options.box, options.neighbour_gap_m)) {
+            judge.Propose(pose, 0, {});
+          }
         }
       }
-      if (clash) continue;
-      det.boxes.push_back(c.box);
-      if (options.propagate_to_neighbours) {
-        for (const Eigen::Isometry3d& pose :
-             NeighbourHypotheses(c.box, options.box, options.neighbour_gap_m)) {
-          judge.Propose(pose, 0, {});
-        }
-      }
+      pending = judge.Evaluate(options.num_threads);
     }
-    pending = judge.Evaluate(options.num_threads);
+  };
+  accept_all();
+  // Face proposals after the corner ones: a tile on a box already found is
+  // not judged again.
+  if (options.face_proposals) {
+    const Clock::time_point t_faces = Clock::now();
+    FaceProposals faces = ProposeFromFaces(depth, options.box, options.faces);
+    for (const Eigen::Isometry3d& pose : faces.poses) {
+      if (!overlaps_kept(pose)) judge.Propose(pose, 0, {}, true);
+    }
+    for (DeclinedCandidate& d : faces.declined) {
+      d.score = MeasureBox(depth, d.camera_T_box, options.box, options.evidence).support();
+      declined.push_back(std::move(d));
+    }
+    det.timings.faces_ms = MsSince(t_faces);
+    accept_all();
   }
   std::stable_sort(det.boxes.begin(), det.boxes.end(),
                    [](const DetectedBox& a, const DetectedBox& b) { return a.score > b.score; });
   det.hypotheses = judge.stats();
+  declined.insert(declined.end(), judge.declined().begin(), judge.declined().end());
+  det.declined = StrongestDeclined(std::move(declined), det.boxes, options);
   det.timings.poses_ms = MsSince(t0);
   det.timings.total_ms = MsSince(t_start);
   return det;

@@ -13,6 +13,7 @@
 #include "common/perception/clubbing.h"
 #include "common/perception/edge_points.h"
 #include "common/perception/edge_segments.h"
+#include "common/perception/face_proposals.h"
 #include "common/perception/types.h"
 
 namespace cornerpose {
@@ -64,6 +65,26 @@ struct DetectorOptions {
   // The camera of an unorganized cloud, used to render hypotheses; organized
   // clouds carry their own (recovered from the points). Default: Kinect VGA.
   std::optional<CameraIntrinsics> camera;
+  // Face-first hypotheses from planar patches (face_proposals.h), judged
+  // with the corner ones. False gives the corner-only detector.
+  bool face_proposals = true;
+  FaceProposalOptions faces;
+  // How far a real box may be off its nominal size (bulge, sag, crushed
+  // corners) and still be the box. Unset keeps each stage's own tolerance
+  // (pose.length_tolerance_m 0.025, acceptance.extent_tolerance_m 0.025,
+  // refinement.tile_tolerance_m 0.01, faces.size_tolerance_m 0.02). Set,
+  // it gives: faces.size_tolerance_m = T, refinement.tile_tolerance_m =
+  // 2/3 T, and pose.length_tolerance_m = acceptance.extent_tolerance_m =
+  // T + 0.01 (what the edge bands and the depth noise add). Metres, (0, 0.1].
+  std::optional<double> size_tolerance_m;
+  // Parameters from geometry: edge_points.radius_m, segments.ransac_threshold_m
+  // and clubbing.meet_distance_m left at their defaults (0.02, 0.01, 0.01)
+  // follow the box size and the frame's median depth z (see
+  // DeriveGeometryParameters); a value the caller changed is kept. False
+  // keeps the defaults as they are.
+  bool parameters_from_geometry = true;
+  // Declined hypotheses reported per frame (the strongest). Count, >= 0.
+  int max_declined = 8;
   // Each confirmed box proposes the boxes that would touch it side by side
   // (pallet layers, where seams leave few edges), neighbour_gap_m apart.
   bool propagate_to_neighbours = true;
@@ -90,6 +111,13 @@ void SetEdgeRadius(double radius_m, DetectorOptions* options);
 // replaces the one in *options (a request's intrinsics, the default); a
 // frame without one leaves *options unchanged.
 void UseFrameCamera(const std::optional<CameraIntrinsics>& frame_camera, DetectorOptions* options);
+
+// The geometry rule, applied to the fields left at their defaults: r_s =
+// min(0.35 x the box's smallest side, max(0.02 m, 6 pixels at depth z));
+// RANSAC threshold and meeting distance r_s / 2; the segment gap r_s. So a
+// 3 cm edge at 0.6 m gets r_s = 1.05 cm; a carton at 1-2.5 m keeps 2 cm.
+// `focal_px` is the camera's fx; z in metres (<= 0: unknown, depth term off).
+void DeriveGeometryParameters(double median_depth_m, double focal_px, DetectorOptions* options);
 
 // Runs the detector on one cloud. Empty, all-NaN and box-free clouds give an
 // empty Detection; malformed clouds and bad options give INVALID_ARGUMENT.

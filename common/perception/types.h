@@ -74,12 +74,23 @@ struct Corner {
   bool b_at_end1 = true;
 };
 
+// A hypothesis the detector did not return, and why: what an integrator
+// reads to tune a cell ("face tiles two ways", "side runs on flat", ...).
+struct DeclinedCandidate {
+  Eigen::Isometry3d camera_T_box = Eigen::Isometry3d::Identity();
+  // Its render-and-compare support before refinement, in [0, 1]; 0 when it
+  // was declined before any (an ambiguous tiling).
+  double score = 0.0;
+  std::string reason;
+};
+
 // Wall-clock time of each stage, milliseconds.
 struct StageTimings {
   double preprocess_ms = 0.0;
   double edge_points_ms = 0.0;
   double edge_segments_ms = 0.0;
   double clubbing_ms = 0.0;
+  double faces_ms = 0.0;  // planar patches and their tilings
   double poses_ms = 0.0;
   double total_ms = 0.0;
 };
@@ -98,6 +109,9 @@ struct Detection {
   std::vector<EdgeSegment> segments;
   std::vector<Corner> corners;
   std::vector<DetectedBox> boxes;  // best score first
+  // The strongest hypotheses not returned, strongest first, each with a
+  // reason (at most DetectorOptions::max_declined).
+  std::vector<DeclinedCandidate> declined;
   StageTimings timings;
   HypothesisStats hypotheses;
 };

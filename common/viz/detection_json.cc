@@ -39,10 +39,19 @@ nlohmann::json DetectionToJson(const Detection& detection, const BoxDims& dims) 
                      {"grasp_centre", Vec(box.grasp_centre_camera)},
                      {"grasp_normal", Vec(box.grasp_normal_camera)},
                      {"num_corners", box.num_corners},
-                     {"segments", box.segments}});
+                     {"segments", box.segments},
+                     {"measured_extent", {box.measured_extent_m[0], box.measured_extent_m[1]}},
+                     {"proposed_by", box.from_face ? "face" : "corner"}});
     detections.push_back({{"pose", Pose(box.camera_T_box)}, {"score", box.score}});
   }
   out["boxes"] = std::move(boxes);
+
+  nlohmann::json declined = nlohmann::json::array();
+  for (const DeclinedCandidate& d : detection.declined) {
+    declined.push_back(
+        {{"camera_T_box", Pose(d.camera_T_box)}, {"score", d.score}, {"reason", d.reason}});
+  }
+  out["declined"] = std::move(declined);
 
   nlohmann::json edges = nlohmann::json::array();
   for (const EdgeSegment& s : detection.segments) {
@@ -65,6 +74,7 @@ nlohmann::json DetectionToJson(const Detection& detection, const BoxDims& dims) 
                        {"edge_points", t.edge_points_ms},
                        {"edge_segments", t.edge_segments_ms},
                        {"clubbing", t.clubbing_ms},
+                       {"faces", t.faces_ms},
                        {"poses", t.poses_ms},
                        {"total", t.total_ms}};
   out["detections"] = std::move(detections);

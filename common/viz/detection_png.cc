@@ -83,6 +83,17 @@ void DrawDepth(const std::vector<float>& depth, Canvas* canvas) {
   }
 }
 
+// The registered colour image, dimmed a little so the overlay stands out.
+void DrawColour(const std::vector<uint32_t>& rgb, Canvas* canvas) {
+  for (int v = 0; v < canvas->height(); ++v) {
+    for (int u = 0; u < canvas->width(); ++u) {
+      const uint32_t c = rgb[static_cast<size_t>(v) * canvas->width() + u];
+      auto dim = [](uint32_t x) { return static_cast<uint8_t>((x & 0xFF) * 3 / 4); };
+      canvas->Set(u, v, {dim(c >> 16), dim(c >> 8), dim(c)});
+    }
+  }
+}
+
 }  // namespace
 
 absl::Status WriteDetectionPng(const std::string& path, const PointCloud& cloud,
@@ -95,7 +106,12 @@ absl::Status WriteDetectionPng(const std::string& path, const PointCloud& cloud,
     return absl::InvalidArgumentError(absl::StrCat(path, ": not drawn: ", s.message()));
   }
   Canvas canvas(camera.width, camera.height);
-  DrawDepth(DepthImage(cloud, camera), &canvas);
+  if (cloud.has_color() && cloud.organized() && cloud.width == camera.width &&
+      cloud.height == camera.height) {
+    DrawColour(cloud.rgb, &canvas);
+  } else {
+    DrawDepth(DepthImage(cloud, camera), &canvas);
+  }
 
   // Boxes first, then the evidence on top: edge points, the segments fitted
   // to them, the corners.

@@ -5,55 +5,81 @@
 #include <cmath>
 #include <thread>
 
+#include "absl/strings/str_format.h"
 #include "common/perception/pose_error.h"
 
 namespace cornerpose::internal {
 
 double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
-                    BoxFace grasp, const AcceptanceOptions& o) {
-  if (!ev.in_front_of_camera || !ref.ok) return -1.0;
+                    BoxFace grasp, const AcceptanceOptions& o, std::string* reason) {
+  auto reject = [&](std::string why) {
+    if (reason != nullptr) *reason = std::move(why);
+    return -1.0;
+  };
+  if (!ev.in_front_of_camera) return reject("not in front of the camera");
+  if (!ref.ok) return reject("refinement moved it too far: not this box");
   const FaceEvidence& g = ev.faces[static_cast<int>(grasp)];
-  if (g.expected < o.min_grasp_pixels) return -1.0;
+  if (g.expected < o.min_grasp_pixels) return reject("grasp face too small in the image");
   const double grasp_occluded = static_cast<double>(g.occluded) / g.expected;
   const double grasp_support = g.visible() > 0 ? static_cast<double>(g.agree) / g.visible() : 0.0;
-  if (grasp_occluded > o.max_grasp_occluded || grasp_support < o.min_grasp_support) return -1.0;
-  if (ev.support() < o.min_support || ev.see_through_fraction() > o.max_see_through) return -1.0;
+  if (grasp_occluded > o.max_grasp_occluded) {
+    return reject(absl::StrFormat("grasp face %.0f%% hidden by something in front",
+                                  100 * grasp_occluded));
+  }
+  if (grasp_support < o.min_grasp_support) {
+    return reject(absl::StrFormat("grasp face only %.0f%% confirmed by the depth",
+                                  100 * grasp_support));
+  }
+  if (ev.support() < o.min_support) {
+    return reject(absl::StrFormat("box only %.0f%% confirmed by the depth", 100 * ev.support()));
+  }
+  if (ev.see_through_fraction() > o.max_see_through) {
+    return reject(absl::StrFormat("%.0f%% of the box seen through (free space where it would be)",
+                                  100 * ev.see_through_fraction()));
+  }
   // A box mostly hidden behind what is in front of it is more often a box
   // pushed through a surface (the floor, a neighbour) than a real one.
   if (ev.total.expected > 0 &&
       static_cast<double>(ev.total.occluded) / ev.total.expected > o.max_occluded) {
-    return -1.0;
+    return reject(absl::StrFormat("%.0f%% of the box hidden: sunk into a surface?",
+                                  100.0 * ev.total.occluded / ev.total.expected));
   }
   // The in-plane position must be measured, not guessed: a free side along
   // each of the face's axes.
   const int fi = static_cast<int>(grasp);
   const int axis_a = (fi / 2 + 1) % 3, axis_b = (fi / 2 + 2) % 3;
-  if (ref.extent_a_m > 0.0 && std::abs(ref.extent_a_m - dims[axis_a]) > o.extent_tolerance_m) {
-    return -1.0;
-  }
-  if (ref.extent_b_m > 0.0 && std::abs(ref.extent_b_m - dims[axis_b]) > o.extent_tolerance_m) {
-    return -1.0;
+  for (const auto& [extent, axis] : {std::pair{ref.extent_a_m, axis_a}, std::pair{ref.extent_b_m, axis_b}}) {
+    if (extent > 0.0 && std::abs(extent - dims[axis]) > o.extent_tolerance_m) {
+      return reject(absl::StrFormat("face measures %.3f m where the box is %.3f m", extent,
+                                    dims[axis]));
+    }
   }
   // Every side that can be seen must end the face: a free border or a seam
   // to a touching box. A face that runs on flat is a bigger face.
   int measured = 0;
   for (SideKind k : ref.sides) {
-    if (k == SideKind::kContinues) return -1.0;
+    if (k == SideKind::kContinues) {
+      return reject("a side runs on flat with no seam (a bigger face, or a layer that does not "
+                    "tile uniquely)");
+    }
     measured += k == SideKind::kFree || k == SideKind::kSeam || k == SideKind::kTiled;
   }
   // At least two sides pin the face down; a face with no free side must be
   // boxed in on all four (by seams or whole tiles of its layer).
-  if (measured < 2 || (ref.free_sides < 1 && measured < 4)) return -1.0;
+  if (measured < 2) return reject("fewer than two sides of the face measured");
+  if (ref.free_sides < 1 && measured < 4) {
+    return reject("no free side and not boxed in by seams on all four");
+  }
   // A side hidden under something may hide more face: keep the box only if
   // no bigger side of the box could stand in for this one there.
   for (int s = 0; s < 4; ++s) {
     if (ref.sides[s] != SideKind::kOccluded) continue;
     const int here = s < 2 ? axis_a : axis_b, other = s < 2 ? axis_b : axis_a;
     for (int k = 0; k < 3; ++k) {
-      if (k != here && k != other && dims[k] > dims[here] + o.extent_tolerance_m) return -1.0;
-      if (k == other && dims[k] > dims[here] + o.extent_tolerance_m &&
-          ref.sides[s < 2 ? 2 : 0] == SideKind::kOccluded) {
-        return -1.0;
+      if ((k != here && k != other && dims[k] > dims[here] + o.extent_tolerance_m) ||
+          (k == other && dims[k] > dims[here] + o.extent_tolerance_m &&
+           ref.sides[s < 2 ? 2 : 0] == SideKind::kOccluded)) {
+        return reject("a hidden side could be a longer side of the box");
       }
     }
   }
@@ -66,24 +92,25 @@ HypothesisJudge::HypothesisJudge(const DepthImage& depth, const DetectorOptions&
     : depth_(depth), options_(options), symmetries_(BoxSymmetries(options.box)) {}
 
 void HypothesisJudge::Propose(const Eigen::Isometry3d& camera_T_box, int corners,
-                              std::vector<int> segments) {
+                              std::vector<int> segments, bool from_face) {
   if (Seen(camera_T_box)) return;
   seen_.push_back(camera_T_box);
   ++stats_.proposed;
-  queue_.push_back({camera_T_box, corners, std::move(segments)});
+  queue_.push_back({camera_T_box, corners, std::move(segments), from_face});
 }
 
 std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
   const int n = static_cast<int>(queue_.size());
   std::vector<Candidate> results(n);
   std::vector<char> accepted(n, 0), refined(n, 0);
+  std::vector<std::string> reasons(n);
   // Work is uneven (most hypotheses fail the first check), so threads take
   // the next hypothesis from a shared counter.
   std::atomic<int> next{0};
   auto worker = [&] {
     for (int i = next++; i < n; i = next++) {
       bool r = false;
-      accepted[i] = EvaluateOne(queue_[i], &results[i], &r);
+      accepted[i] = EvaluateOne(queue_[i], &results[i], &r, &reasons[i]);
       refined[i] = r;
     }
   };
@@ -94,7 +121,13 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
   std::vector<Candidate> out;
   for (int i = 0; i < n; ++i) {
     stats_.refined += refined[i];
-    if (!accepted[i]) continue;
+    if (!accepted[i]) {
+      if (refined[i]) {
+        declined_.push_back({results[i].box.camera_T_box, results[i].box.score,
+                             std::move(reasons[i])});
+      }
+      continue;
+    }
     ++stats_.accepted;
     out.push_back(std::move(results[i]));
   }
@@ -102,11 +135,13 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
   return out;
 }
 
-bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refined) const {
+bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refined,
+                                  std::string* reason) const {
   Candidate& cand = *out;
   cand.box.camera_T_box = p.camera_T_box;
   cand.box.num_corners = p.corners;
   cand.box.segments = p.segments;
+  cand.box.from_face = p.from_face;
   const BoxEvidence first = MeasureBox(depth_, p.camera_T_box, options_.box, options_.evidence);
   // Refinement moves a hypothesis by centimetres at most: one that the
   // depth image already rejects by a wide margin is not worth refining.
@@ -120,16 +155,19 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   // lie inside the image (checked below).
   if (!GraspFaceInView(p.camera_T_box, grasp, -20.0)) return false;
   *refined = true;
+  cand.box.score = first.support();  // what a declined candidate reports
   cand.refinement =
       RefineOnGraspFace(depth_, options_.box, grasp, options_.refinement, &cand.box.camera_T_box);
   cand.evidence = MeasureBox(depth_, cand.box.camera_T_box, options_.box, options_.evidence);
-  const double score =
-      JudgeRefined(cand.evidence, cand.refinement, options_.box, grasp, options_.acceptance);
-  if (score < 0.0 ||
-      !GraspFaceInView(cand.box.camera_T_box, grasp, options_.acceptance.border_margin_px)) {
+  const double score = JudgeRefined(cand.evidence, cand.refinement, options_.box, grasp,
+                                    options_.acceptance, reason);
+  if (score < 0.0) return false;
+  if (!GraspFaceInView(cand.box.camera_T_box, grasp, options_.acceptance.border_margin_px)) {
+    *reason = "grasp face cut by the image border";
     return false;
   }
   cand.box.score = score;
+  cand.box.measured_extent_m = {cand.refinement.extent_a_m, cand.refinement.extent_b_m};
   cand.box.grasp_face = cand.evidence.grasp_face;
   const Eigen::Vector3d n_box = BoxFaceNormal(cand.box.grasp_face);
   const int axis = static_cast<int>(cand.box.grasp_face) / 2;
@@ -139,7 +177,11 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   // box by, and is where the sides of pallets and bins pass for one.
   const double cos_view =
       -cand.box.grasp_normal_camera.dot(cand.box.grasp_centre_camera.normalized());
-  return cos_view >= std::cos(options_.acceptance.max_grasp_view_angle_deg * M_PI / 180.0);
+  if (cos_view < std::cos(options_.acceptance.max_grasp_view_angle_deg * M_PI / 180.0)) {
+    *reason = "grasp face seen too obliquely";
+    return false;
+  }
+  return true;
 }
 
 // A face cut by the image border cannot be checked to its end (and a

@@ -4,6 +4,7 @@
 // in parallel; each evaluation only reads the depth image.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "common/perception/box_evidence.h"
@@ -21,9 +22,10 @@ struct Candidate {
 };
 
 // The acceptance test of a refined hypothesis: its score in [0, 1], or < 0
-// when the depth image contradicts it (see AcceptanceOptions).
+// when the depth image contradicts it (see AcceptanceOptions); then
+// `reason`, when given, says which test failed.
 double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
-                    BoxFace grasp, const AcceptanceOptions& o);
+                    BoxFace grasp, const AcceptanceOptions& o, std::string* reason = nullptr);
 
 class HypothesisJudge {
  public:
@@ -32,23 +34,29 @@ class HypothesisJudge {
   // Queues a pose unless one like it (same place within 1 cm, same
   // orientation up to the box's symmetries) was proposed before: the
   // corners of one box propose it many times.
-  void Propose(const Eigen::Isometry3d& camera_T_box, int corners, std::vector<int> segments);
+  void Propose(const Eigen::Isometry3d& camera_T_box, int corners, std::vector<int> segments,
+               bool from_face = false);
 
   // Evaluates the queue on up to `threads` threads; returns the accepted
   // candidates in the order they were proposed, and empties the queue.
+  // Hypotheses that got as far as refinement and failed are kept, with the
+  // reason, in declined().
   std::vector<Candidate> Evaluate(int threads);
 
   const HypothesisStats& stats() const { return stats_; }
+  const std::vector<DeclinedCandidate>& declined() const { return declined_; }
 
  private:
   struct Proposal {
     Eigen::Isometry3d camera_T_box;
     int corners;
     std::vector<int> segments;
+    bool from_face;
   };
   // Evaluates one proposal; false when rejected. `refined` is set when it
-  // got as far as refinement.
-  bool EvaluateOne(const Proposal& p, Candidate* out, bool* refined) const;
+  // got as far as refinement; then `reason` says why it was rejected, and
+  // out->box holds the refined pose and out->box.score its first support.
+  bool EvaluateOne(const Proposal& p, Candidate* out, bool* refined, std::string* reason) const;
   bool GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face, double margin) const;
   bool Seen(const Eigen::Isometry3d& pose) const;
 
@@ -58,6 +66,7 @@ class HypothesisJudge {
   std::vector<Eigen::Isometry3d> seen_;
   std::vector<Proposal> queue_;
   HypothesisStats stats_;
+  std::vector<DeclinedCandidate> declined_;
 };
 
 }  // namespace cornerpose::internal

@@ -1,0 +1,291 @@
+#include "common/perception/face_proposals.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+
+namespace cornerpose {
+namespace {
+
+// How many faces of `size` laid side by side, 0 to max_gap_m apart, make a
+// run of `extent`; 0 when no whole number does.
+int FaceCount(double extent, double size, const FaceProposalOptions& o) {
+  const int k = static_cast<int>(std::lround(extent / size));
+  if (k < 1) return 0;
+  const double slack = extent - k * size;
+  return slack >= -o.size_tolerance_m && slack <= (k - 1) * o.max_gap_m + o.size_tolerance_m ? k
+                                                                                              : 0;
+}
+
+std::string Describe(const FaceTiling& t, const BoxDims& dims) {
+  return absl::StrFormat("%d x %d faces of %.3f x %.3f m", t.count_u, t.count_v, dims[t.axis_u],
+                         dims[t.axis_v]);
+}
+
+// The 2D convex hull (Andrew's monotone chain), counter-clockwise.
+std::vector<Eigen::Vector2d> ConvexHull(std::vector<Eigen::Vector2d> p) {
+  std::sort(p.begin(), p.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (p.size() < 3) return p;
+  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  std::vector<Eigen::Vector2d> hull(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+    hull[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross(hull[k - 2], hull[k - 1], p[i - 1]) <= 0) --k;
+    hull[k++] = p[i - 1];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+Eigen::Isometry3d TilePose(const PlaneRectangle& rect, const FaceTiling& t, const BoxDims& dims,
+                           double u, double v) {
+  Eigen::Matrix3d R;
+  R.col(t.normal_axis) = rect.normal;
+  R.col(t.axis_u) = rect.axis_u;
+  R.col(t.axis_v) = rect.axis_v;
+  if (R.determinant() < 0.0) R.col(t.axis_v) = -rect.axis_v;  // the box is symmetric
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = R;
+  pose.translation() = rect.centre + u * rect.axis_u + v * rect.axis_v -
+                       0.5 * dims[t.normal_axis] * rect.normal;
+  return pose;
+}
+
+}  // namespace
+
+absl::Status FaceProposalOptions::Validate() const {
+  if (absl::Status s = patches.Validate(); !s.ok()) return s;
+  if (absl::Status s = seams.Validate(); !s.ok()) return s;
+  if (!(size_tolerance_m > 0.0 && size_tolerance_m <= 0.1) ||
+      !(max_gap_m >= 0.0 && max_gap_m <= 0.05) ||
+      !(max_view_angle_deg > 0.0 && max_view_angle_deg < 90.0) || max_tiles < 1 ||
+      !(min_seam_support > 0.0 && min_seam_support <= 1.0)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "face proposal options out of range: size_tolerance_m=", size_tolerance_m,
+        " (0, 0.1], max_gap_m=", max_gap_m, " [0, 0.05], max_view_angle_deg=", max_view_angle_deg,
+        " (0, 90), max_tiles=", max_tiles, " >= 1, min_seam_support=", min_seam_support,
+        " (0, 1]"));
+  }
+  return absl::OkStatus();
+}
+
+std::vector<FaceTiling> TilingsOf(double width_m, double height_m, const BoxDims& dims,
+                                  const FaceProposalOptions& o) {
+  std::vector<FaceTiling> out;
+  for (int n = 0; n < 3; ++n) {
+    const int a = (n + 1) % 3, b = (n + 2) % 3;
+    for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {
+      FaceTiling t{n, su, sv, FaceCount(width_m, dims[su], o), FaceCount(height_m, dims[sv], o)};
+      if (t.count_u == 0 || t.count_v == 0 || t.tiles() > o.max_tiles) continue;
+      // Equal sides give the same tiling twice (the box's symmetries). The
+      // lambda takes t's copies: clang 14 cannot capture structured bindings.
+      const bool repeat = std::any_of(out.begin(), out.end(), [&](const FaceTiling& q) {
+        return std::abs(dims[q.axis_u] - dims[t.axis_u]) < 1e-4 &&
+               std::abs(dims[q.axis_v] - dims[t.axis_v]) < 1e-4 &&
+               std::abs(dims[q.normal_axis] - dims[n]) < 1e-4;
+      });
+      if (!repeat) out.push_back(t);
+    }
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const FaceTiling& x, const FaceTiling& y) { return x.tiles() < y.tiles(); });
+  return out;
+}
+
+PlaneRectangle OutlineRectangle(const PlanarPatch& patch) {
+  PlaneRectangle rect;
+  rect.normal = patch.normal;
+  const Eigen::Vector3d e1 = patch.normal.unitOrthogonal();
+  const Eigen::Vector3d e2 = patch.normal.cross(e1);
+  std::vector<Eigen::Vector2d> flat;
+  flat.reserve(patch.points.size());
+  for (const Eigen::Vector3d& p : patch.points) {
+    const Eigen::Vector3d d = p - patch.centroid;
+    flat.emplace_back(d.dot(e1), d.dot(e2));
+  }
+  const std::vector<Eigen::Vector2d> hull = ConvexHull(flat);
+  double best_area = std::numeric_limits<double>::max();
+  for (size_t i = 0; i < hull.size(); ++i) {
+    const Eigen::Vector2d edge = hull[(i + 1) % hull.size()] - hull[i];
+    if (edge.norm() < 1e-9) continue;
+    const Eigen::Vector2d u = edge.normalized(), v(-u.y(), u.x());
+    double u0 = 1e9, u1 = -1e9, v0 = 1e9, v1 = -1e9;
+    for (const Eigen::Vector2d& q : hull) {
+      u0 = std::min(u0, q.dot(u));
+      u1 = std::max(u1, q.dot(u));
+      v0 = std::min(v0, q.dot(v));
+      v1 = std::max(v1, q.dot(v));
+    }
+    const double area = (u1 - u0) * (v1 - v0);
+    if (area >= best_area) continue;
+    best_area = area;
+    rect.axis_u = u.x() * e1 + u.y() * e2;
+    rect.axis_v = v.x() * e1 + v.y() * e2;
+    rect.width = u1 - u0;
+    rect.height = v1 - v0;
+    const Eigen::Vector2d c = 0.5 * (u0 + u1) * u + 0.5 * (v0 + v1) * v;
+    rect.centre = patch.centroid + c.x() * e1 + c.y() * e2;
+  }
+  return rect;
+}
+
+std::vector<Eigen::Isometry3d> TilePoses(const PlaneRectangle& rect, const FaceTiling& t,
+                                         const BoxDims& dims) {
+  std::vector<Eigen::Isometry3d> out;
+  // Tiles spread evenly over the outline, so the gaps share its slack.
+  const double step_u = rect.width / t.count_u, step_v = rect.height / t.count_v;
+  for (int i = 0; i < t.count_u; ++i) {
+    for (int j = 0; j < t.count_v; ++j) {
+      out.push_back(TilePose(rect, t, dims, -0.5 * rect.width + (i + 0.5) * step_u,
+                             -0.5 * rect.height + (j + 0.5) * step_v));
+    }
+  }
+  return out;
+}
+
+double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const FaceTiling& t,
+                   const BoxDims& dims, const SeamCueOptions& options) {
+  (void)dims;
+  if (!image.has_grey() || t.tiles() < 2) return 0.0;
+  const double step_u = rect.width / t.count_u, step_v = rect.height / t.count_v;
+  const Eigen::Vector3d corner = rect.centre - 0.5 * rect.width * rect.axis_u -
+                                 0.5 * rect.height * rect.axis_v;
+  int sides = 0, seams = 0;
+  // Lines between columns (across u), one side per row; then between rows.
+  for (int i = 1; i < t.count_u; ++i) {
+    for (int j = 0; j < t.count_v; ++j) {
+      const Eigen::Vector3d a = corner + i * step_u * rect.axis_u + j * step_v * rect.axis_v;
+      ++sides;
+      seams += ColourSeamAlong(image, a, a + step_v * rect.axis_v, rect.axis_u, options).seam;
+    }
+  }
+  for (int j = 1; j < t.count_v; ++j) {
+    for (int i = 0; i < t.count_u; ++i) {
+      const Eigen::Vector3d a = corner + i * step_u * rect.axis_u + j * step_v * rect.axis_v;
+      ++sides;
+      seams += ColourSeamAlong(image, a, a + step_u * rect.axis_u, rect.axis_v, options).seam;
+    }
+  }
+  return sides > 0 ? static_cast<double>(seams) / sides : 0.0;
+}
+
+FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
+                               const FaceProposalOptions& o) {
+  FaceProposals out;
+  const PlanarPatches patches = SegmentPlanarPatches(image, o.patches);
+  out.num_patches = static_cast<int>(patches.patches.size());
+  std::array<double, 3> sorted = {dims.l, dims.b, dims.h};
+  std::sort(sorted.begin(), sorted.end());
+  const double smallest_face = sorted[0] * sorted[1];
+  const double cos_view = std::cos(o.max_view_angle_deg * std::numbers::pi / 180.0);
+  for (size_t id = 0; id < patches.patches.size(); ++id) {
+    const PlanarPatch& patch = patches.patches[id];
+    const double cell_m = patch.centroid.z() / image.camera.fx * patches.step_px;
+    const double area = patch.points.size() * cell_m * cell_m;
+    if (area < 0.5 * smallest_face) continue;
+    if (patch.normal.dot(-patch.centroid.normalized()) < cos_view) continue;
+    // An outline cut by the image border says nothing about where the face
+    // ends.
+    if (patch.touches_border) continue;
+    const PlaneRectangle rect = OutlineRectangle(patch);
+    // A patch filling little of its outline is no face or layer (a floor
+    // around things, an L of two boxes' sides).
+    if (area < 0.5 * rect.width * rect.height) continue;
+    // A tile is proposed only where the patch is (a layer can be notched
+    // where boxes were taken).
+    auto on_patch = [&](const Eigen::Isometry3d& pose, const FaceTiling& t) {
+      const Eigen::Vector3d face_centre = pose.translation() + 0.5 * dims[t.normal_axis] * rect.normal;
+      if (face_centre.z() <= 0.05) return false;
+      const Eigen::Vector2d px = Project(image.camera, face_centre);
+      const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+      for (int dv = -1; dv <= 1; ++dv) {
+        for (int du = -1; du <= 1; ++du) {
+          if (patches.PatchAt(u + du * patches.step_px, v + dv * patches.step_px) ==
+              static_cast<int>(id)) {
+            return true;
+          }
+        }
+      }
+      return false;
+    };
+    auto propose = [&](const FaceTiling& t) {
+      for (const Eigen::Isometry3d& pose : TilePoses(rect, t, dims)) {
+        if (on_patch(pose, t)) out.poses.push_back(pose);
+      }
+    };
+    const std::vector<FaceTiling> tilings = TilingsOf(rect.width, rect.height, dims, o);
+    if (tilings.empty()) {
+      // Not a whole number of faces (part of it hidden or out of view): a
+      // face in each corner of the outline, for each way one fits in it;
+      // only for an outline about one face in size (a bigger one is a
+      // floor, a wall, a layer cut by the image border).
+      const double largest = sorted[2] + o.size_tolerance_m;
+      if (rect.width > largest || rect.height > largest) continue;
+      for (int n = 0; n < 3; ++n) {
+        const int a = (n + 1) % 3, b = (n + 2) % 3;
+        for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {
+          if (dims[su] > rect.width + o.size_tolerance_m ||
+              dims[sv] > rect.height + o.size_tolerance_m) {
+            continue;
+          }
+          const FaceTiling t{n, su, sv, 1, 1};
+          for (double cu : {-1.0, 1.0}) {
+            for (double cv : {-1.0, 1.0}) {
+              const Eigen::Isometry3d pose =
+                  TilePose(rect, t, dims, cu * 0.5 * (rect.width - dims[su]),
+                           cv * 0.5 * (rect.height - dims[sv]));
+              if (on_patch(pose, t)) out.poses.push_back(pose);
+            }
+          }
+        }
+      }
+      continue;
+    }
+    if (tilings.size() == 1) {
+      propose(tilings[0]);
+      continue;
+    }
+    // Several tilings fit: seam cues first, then the fewest boxes.
+    std::vector<double> support(tilings.size(), 0.0);
+    for (size_t i = 0; i < tilings.size(); ++i) {
+      support[i] = SeamSupport(image, rect, tilings[i], dims, o.seams);
+    }
+    const size_t best = std::max_element(support.begin(), support.end()) - support.begin();
+    int chosen = -1;
+    if (support[best] >= o.min_seam_support) {
+      bool alone = true;
+      for (size_t i = 0; i < tilings.size(); ++i) {
+        if (i != best && support[i] > support[best] - o.seam_support_margin) alone = false;
+      }
+      if (alone) chosen = static_cast<int>(best);
+    } else if (tilings[0].tiles() < tilings[1].tiles()) {
+      chosen = 0;
+    }
+    if (chosen >= 0) {
+      propose(tilings[chosen]);
+      continue;
+    }
+    for (size_t i = 0; i < tilings.size() && i < 2; ++i) {
+      DeclinedCandidate d;
+      d.camera_T_box = TilePoses(rect, tilings[i], dims).front();
+      d.reason = absl::StrFormat(
+          "face %.3f x %.3f m tiles two ways (%s, or %s) and no seam cue decides", rect.width,
+          rect.height, Describe(tilings[0], dims), Describe(tilings[1], dims));
+      out.declined.push_back(d);
+    }
+  }
+  return out;
+}
+
+}  // namespace cornerpose

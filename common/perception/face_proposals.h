@@ -1,0 +1,88 @@
+// Face-first box hypotheses, beside the paper's corner-first ones. The frame
+// is cut into planar patches (planar_patches.h); a patch whose plane and
+// outline fit a face of the box (l x b, l x h or b x h), or a whole number
+// of such faces side by side (a pallet layer of touching cartons), proposes
+// the box-sized rectangles that tile its outline (its minimum-area
+// rectangle), anchored on its sides and corners. When two tilings fit the
+// outline, seam cues inside it decide (colour lines along the seams a
+// tiling needs, seam_cues.h); with no cue to decide, the fewest boxes win
+// (a face twice a side's width is one face, not two), and two tilings with
+// as few boxes each are declined. Every proposal still goes through the
+// same render-and-compare judge as the corner hypotheses.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "common/perception/camera_model.h"
+#include "common/perception/planar_patches.h"
+#include "common/perception/seam_cues.h"
+#include "common/perception/types.h"
+
+namespace cornerpose {
+
+struct FaceProposalOptions {
+  PlanarPatchOptions patches;
+  SeamCueOptions seams;
+  // A run of n faces fits an outline side when it is n sizes plus 0 to
+  // (n - 1) max_gap_m long, within size_tolerance_m. Metres.
+  double size_tolerance_m = 0.02;
+  double max_gap_m = 0.005;
+  // Patches seen more obliquely than this are not proposed from. Degrees.
+  double max_view_angle_deg = 65.0;
+  // A patch with more tiles than this is not tiled. Count.
+  int max_tiles = 64;
+  // A tiling is backed by seam cues when this share of its inner tile
+  // sides shows one; it wins when every other tiling's share is lower by
+  // seam_support_margin (a finer tiling that shares its seams has sides
+  // with none). Unitless.
+  double min_seam_support = 0.5;
+  double seam_support_margin = 0.25;
+
+  absl::Status Validate() const;
+};
+
+// One way to tile a rectangular outline with equal faces of the box.
+struct FaceTiling {
+  int normal_axis = 2;  // box axis along the face normal
+  int axis_u = 0;       // box axis along the outline's first side
+  int axis_v = 1;       // box axis along its second side
+  int count_u = 1, count_v = 1;
+  int tiles() const { return count_u * count_v; }
+};
+
+// The tilings of a width x height outline (metres) by one face of the box,
+// each distinct in face size; fewest tiles first.
+std::vector<FaceTiling> TilingsOf(double width_m, double height_m, const BoxDims& dims,
+                                  const FaceProposalOptions& options);
+
+// A rectangle on a plane: centre, unit in-plane axes, extents. Metres.
+struct PlaneRectangle {
+  Eigen::Vector3d centre, normal, axis_u, axis_v;
+  double width = 0.0, height = 0.0;  // along axis_u, axis_v
+};
+
+// The minimum-area rectangle around a patch's points, on its plane.
+PlaneRectangle OutlineRectangle(const PlanarPatch& patch);
+
+// Poses of the tiles of `tiling` over `rect` (box behind the face, its
+// normal_axis face towards the camera).
+std::vector<Eigen::Isometry3d> TilePoses(const PlaneRectangle& rect, const FaceTiling& tiling,
+                                         const BoxDims& dims);
+
+// Share of the inner tile sides of `tiling` over `rect` that show a colour
+// seam (0 without colour or inner sides).
+double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const FaceTiling& tiling,
+                   const BoxDims& dims, const SeamCueOptions& options);
+
+struct FaceProposals {
+  std::vector<Eigen::Isometry3d> poses;
+  std::vector<DeclinedCandidate> declined;  // ambiguous tilings
+  int num_patches = 0;
+};
+
+FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
+                               const FaceProposalOptions& options);
+
+}  // namespace cornerpose

@@ -1,0 +1,216 @@
+#include "common/perception/planar_patches.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <numeric>
+
+#include "absl/strings/str_cat.h"
+
+namespace cornerpose {
+namespace {
+
+// Running sums of points for a plane fit.
+struct Moments {
+  double n = 0;
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d ss = Eigen::Matrix3d::Zero();
+  void Add(const Eigen::Vector3d& p) {
+    n += 1;
+    s += p;
+    ss += p * p.transpose();
+  }
+  // Normal (smallest eigenvector, towards the camera), centroid, and the
+  // eigenvalues ascending.
+  void Fit(Eigen::Vector3d* normal, Eigen::Vector3d* centroid, Eigen::Vector3d* eig) const {
+    *centroid = s / n;
+    const Eigen::Matrix3d cov = ss / n - *centroid * centroid->transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(cov);
+    *normal = solver.eigenvectors().col(0);
+    if (normal->dot(*centroid) > 0) *normal = -*normal;
+    *eig = solver.eigenvalues().cwiseMax(0.0);
+  }
+};
+
+}  // namespace
+
+absl::Status PlanarPatchOptions::Validate() const {
+  if (step_px < 1 || step_px > 8 || window_cells < 1 || window_cells > 8 ||
+      !(max_curvature > 0.0 && max_curvature < 1.0 / 3.0) ||
+      !(max_normal_angle_deg > 0.0 && max_normal_angle_deg < 90.0) ||
+      !(plane_tolerance_base_m > 0.0 && plane_tolerance_base_m < 0.1) ||
+      !(plane_tolerance_per_m2 >= 0.0 && plane_tolerance_per_m2 < 0.1) || min_cells < 4) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "planar patch options out of range: step_px=", step_px, " [1, 8], window_cells=",
+        window_cells, " [1, 8], max_curvature=", max_curvature, " (0, 1/3), max_normal_angle_deg=",
+        max_normal_angle_deg, " (0, 90), plane_tolerance_base_m=", plane_tolerance_base_m,
+        " (0, 0.1), plane_tolerance_per_m2=", plane_tolerance_per_m2, " [0, 0.1), min_cells=",
+        min_cells, " >= 4"));
+  }
+  return absl::OkStatus();
+}
+
+int PlanarPatches::PatchAt(int u, int v) const {
+  const int cu = u / step_px, cv = v / step_px;
+  if (u < 0 || v < 0 || cu >= cells_wide || cv >= cells_high) return -1;
+  return label[static_cast<size_t>(cv) * cells_wide + cu];
+}
+
+PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOptions& o) {
+  PlanarPatches out;
+  const CameraIntrinsics& k = depth.camera;
+  const int s = o.step_px;
+  const int W = k.width / s, H = k.height / s;
+  out.cells_wide = W;
+  out.cells_high = H;
+  out.step_px = s;
+  out.label.assign(static_cast<size_t>(W) * H, -1);
+  if (W < 3 || H < 3 || depth.z.size() != static_cast<size_t>(k.width) * k.height) return out;
+  const size_t N = static_cast<size_t>(W) * H;
+  // The cell's point: the pixel at its centre.
+  std::vector<Eigen::Vector3d> point(N);
+  std::vector<char> valid(N, 0);
+  for (int cv = 0; cv < H; ++cv) {
+    for (int cu = 0; cu < W; ++cu) {
+      const int u = cu * s + s / 2, v = cv * s + s / 2;
+      const float z = depth.at(u, v);
+      if (std::isnan(z) || z <= 0.0f) continue;
+      const size_t i = static_cast<size_t>(cv) * W + cu;
+      point[i] = static_cast<double>(z) * PixelRay(k, u, v);
+      valid[i] = 1;
+    }
+  }
+  // Integral images of the point moments: 1, x, y, z, xx, xy, xz, yy, yz, zz.
+  constexpr int kM = 10;
+  std::vector<double> integral(static_cast<size_t>(W + 1) * (H + 1) * kM, 0.0);
+  auto at = [&](int cu, int cv) { return &integral[(static_cast<size_t>(cv) * (W + 1) + cu) * kM]; };
+  for (int cv = 0; cv < H; ++cv) {
+    double row[kM] = {};
+    for (int cu = 0; cu < W; ++cu) {
+      const size_t i = static_cast<size_t>(cv) * W + cu;
+      if (valid[i]) {
+        const Eigen::Vector3d& p = point[i];
+        const double m[kM] = {1, p.x(), p.y(), p.z(), p.x() * p.x(), p.x() * p.y(),
+                              p.x() * p.z(), p.y() * p.y(), p.y() * p.z(), p.z() * p.z()};
+        for (int j = 0; j < kM; ++j) row[j] += m[j];
+      }
+      double* dst = at(cu + 1, cv + 1);
+      const double* up = at(cu + 1, cv);
+      for (int j = 0; j < kM; ++j) dst[j] = up[j] + row[j];
+    }
+  }
+  // Per cell: the window's normal and curvature.
+  const int r = o.window_cells;
+  const int min_window = (2 * r + 1) * (2 * r + 1) / 2;
+  std::vector<Eigen::Vector3f> normal(N, Eigen::Vector3f::Zero());
+  std::vector<float> curvature(N, 1.0f);
+  for (int cv = r; cv < H - r; ++cv) {
+    for (int cu = r; cu < W - r; ++cu) {
+      const size_t i = static_cast<size_t>(cv) * W + cu;
+      if (!valid[i]) continue;
+      const double *a = at(cu - r, cv - r), *b = at(cu + r + 1, cv - r), *c = at(cu - r, cv + r + 1),
+                   *d = at(cu + r + 1, cv + r + 1);
+      double m[kM];
+      for (int j = 0; j < kM; ++j) m[j] = d[j] - b[j] - c[j] + a[j];
+      if (m[0] < min_window) continue;
+      Moments mo;
+      mo.n = m[0];
+      mo.s = {m[1], m[2], m[3]};
+      mo.ss << m[4], m[5], m[6], m[5], m[7], m[8], m[6], m[8], m[9];
+      Eigen::Vector3d n, centroid, eig;
+      mo.Fit(&n, &centroid, &eig);
+      const double sum = eig.sum();
+      if (!(sum > 0.0)) continue;
+      normal[i] = n.cast<float>();
+      curvature[i] = static_cast<float>(eig(0) / sum);
+    }
+  }
+  // Seeds flattest first.
+  std::vector<int> order;
+  for (size_t i = 0; i < N; ++i) {
+    if (curvature[i] < o.max_curvature) order.push_back(static_cast<int>(i));
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return curvature[a] < curvature[b]; });
+  const double cos_max = std::cos(o.max_normal_angle_deg * M_PI / 180.0);
+  auto tolerance = [&](double z) {
+    return o.plane_tolerance_base_m + o.plane_tolerance_per_m2 * z * z;
+  };
+  std::vector<int> members;
+  std::deque<int> queue;
+  for (int seed : order) {
+    if (out.label[seed] != -1) continue;
+    const int id = static_cast<int>(out.patches.size());
+    Moments mo;
+    Eigen::Vector3d n = normal[seed].cast<double>(), c = point[seed];
+    members.clear();
+    queue.clear();
+    queue.push_back(seed);
+    out.label[seed] = id;
+    double refit_at = 16;
+    while (!queue.empty()) {
+      const int i = queue.front();
+      queue.pop_front();
+      members.push_back(i);
+      mo.Add(point[i]);
+      if (mo.n >= refit_at) {  // the plane follows the region as it grows
+        Eigen::Vector3d eig;
+        mo.Fit(&n, &c, &eig);
+        refit_at *= 1.5;
+      }
+      const int cu = i % W, cv = i / W;
+      const int nbs[4][2] = {{cu + 1, cv}, {cu - 1, cv}, {cu, cv + 1}, {cu, cv - 1}};
+      for (const auto& nb : nbs) {
+        if (nb[0] < 0 || nb[1] < 0 || nb[0] >= W || nb[1] >= H) continue;
+        const int j = nb[1] * W + nb[0];
+        if (out.label[j] != -1 || curvature[j] >= o.max_curvature) continue;
+        if (normal[j].cast<double>().dot(n) < cos_max) continue;
+        if (std::abs(n.dot(point[j] - c)) > tolerance(point[j].z())) continue;
+        out.label[j] = id;
+        queue.push_back(j);
+      }
+    }
+    // The rim: valid cells next to the region whose point lies on its
+    // plane, up to the window's half size out.
+    std::vector<int> frontier = members;
+    for (int ring = 0; ring <= r && !frontier.empty(); ++ring) {
+      std::vector<int> next;
+      for (int i : frontier) {
+        const int cu = i % W, cv = i / W;
+        const int nbs[4][2] = {{cu + 1, cv}, {cu - 1, cv}, {cu, cv + 1}, {cu, cv - 1}};
+        for (const auto& nb : nbs) {
+          if (nb[0] < 0 || nb[1] < 0 || nb[0] >= W || nb[1] >= H) continue;
+          const int j = nb[1] * W + nb[0];
+          if (out.label[j] != -1 || !valid[j]) continue;
+          if (std::abs(n.dot(point[j] - c)) > 0.5 * tolerance(point[j].z())) continue;
+          out.label[j] = id;
+          next.push_back(j);
+          members.push_back(j);
+        }
+      }
+      frontier = std::move(next);
+    }
+    if (static_cast<int>(members.size()) < o.min_cells) {
+      for (int i : members) out.label[i] = -2;  // taken, but no patch
+      continue;
+    }
+    PlanarPatch patch;
+    Moments all;
+    patch.points.reserve(members.size());
+    for (int i : members) {
+      const int cu = i % W, cv = i / W;
+      patch.touches_border |= cu <= r || cv <= r || cu >= W - 1 - r || cv >= H - 1 - r;
+      patch.points.push_back(point[i]);
+      all.Add(point[i]);
+    }
+    Eigen::Vector3d eig;
+    all.Fit(&patch.normal, &patch.centroid, &eig);
+    patch.rms_m = std::sqrt(eig(0));
+    out.patches.push_back(std::move(patch));
+  }
+  for (int& l : out.label) l = std::max(l, -1);
+  return out;
+}
+
+}  // namespace cornerpose

@@ -1,0 +1,59 @@
+// Planar patches of an organized frame: region growing over a grid of
+// per-cell normals. Each cell's normal and flatness come from the points of
+// a window around it (sums kept in integral images, so every window costs
+// the same); a region grows from the flattest cells through neighbours whose
+// normal stays within an angle of the region's and whose point lies on the
+// region's plane, then takes in the points at its rim that lie on the plane
+// (the windows there straddle the face's border). Touching coplanar boxes
+// with no depth seam between them make one patch: the face proposals tile it.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "common/perception/camera_model.h"
+
+namespace cornerpose {
+
+struct PlanarPatchOptions {
+  // One cell per step_px x step_px pixels. Pixels, 1-8.
+  int step_px = 4;
+  // Half size of the normal window, in cells (2: 5 x 5 cells). 1-8.
+  int window_cells = 2;
+  // A cell is flat when its window's smallest eigenvalue is below this share
+  // of the sum (windows across a depth jump or a crease are not). Unitless.
+  double max_curvature = 0.05;
+  // A cell joins a region when its normal is within this of the region's.
+  // Degrees.
+  double max_normal_angle_deg = 12.0;
+  // ... and its point lies within base + per_m2 z^2 of the region's plane.
+  // Metres, 1/metre.
+  double plane_tolerance_base_m = 0.005;
+  double plane_tolerance_per_m2 = 0.003;
+  // Regions with fewer cells are dropped. Count.
+  int min_cells = 12;
+
+  absl::Status Validate() const;
+};
+
+struct PlanarPatch {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, towards the camera
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // metres, camera frame
+  double rms_m = 0.0;                                  // of the points about the plane
+  std::vector<Eigen::Vector3d> points;                 // one per cell, camera frame
+  bool touches_border = false;  // some cell at the image border: its outline is cut
+};
+
+struct PlanarPatches {
+  std::vector<PlanarPatch> patches;
+  // Per cell (row-major, cells_wide x cells_high): the patch index, or -1.
+  std::vector<int> label;
+  int cells_wide = 0, cells_high = 0, step_px = 1;
+  // The patch at a pixel, or -1.
+  int PatchAt(int u, int v) const;
+};
+
+PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOptions& options);
+
+}  // namespace cornerpose

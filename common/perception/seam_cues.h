@@ -1,0 +1,49 @@
+// Seam cues from a registered colour image. Two boxes that touch leave a
+// line in the image where they meet (a darker gap, a change of shade) even
+// where the depth shows nothing. A seam is a straight line that runs the
+// whole side of a box-sized rectangle: the edges of tape, labels, print and
+// barcodes inside a face are lines too, but they do not run a whole side at
+// one offset, so they cannot make one.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "absl/status/status.h"
+#include "common/perception/camera_model.h"
+
+namespace cornerpose {
+
+struct SeamCueOptions {
+  // Least brightness contrast (0-255 grey levels) across the line at a
+  // sample: a step between the two sides or a valley darker than both.
+  double min_contrast = 10.0;
+  // Share of the samples along the side (its ends left out) that must show
+  // the line at one offset. Unitless, (0, 1].
+  double min_coverage = 0.75;
+  // The line is looked for this far either side of the hypothesised side
+  // (registration of colour to depth is good to a few pixels). Pixels.
+  double search_px = 3.0;
+  // The two sides of the line are read this far from it. Pixels.
+  double flank_px = 2.0;
+  // Share of the side's length left out at each end (corners blur). Unitless.
+  double end_margin = 0.12;
+  // The samples that show the line must agree on its offset within this.
+  // Pixels.
+  double straightness_px = 1.5;
+
+  absl::Status Validate() const;
+};
+
+struct SeamCue {
+  double coverage = 0.0;   // share of samples showing the line at its offset
+  double offset_m = 0.0;   // where the line lies, along `across` from the side
+  bool seam = false;       // coverage >= min_coverage
+};
+
+// Looks for a seam along the side from a to b (camera frame, metres) on a
+// face; `across` is the face's in-plane unit direction across the side.
+// Without a colour image, or with the side out of view, returns no seam.
+SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                        const Eigen::Vector3d& across, const SeamCueOptions& options);
+
+}  // namespace cornerpose

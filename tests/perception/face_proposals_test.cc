@@ -1,0 +1,251 @@
+// Face-first proposals: planar patches, the tilings of a patch's outline,
+// the choice between tilings, and the colour seam cue.
+#include "common/perception/face_proposals.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "common/perception/planar_patches.h"
+#include "common/perception/seam_cues.h"
+
+namespace cornerpose {
+namespace {
+
+constexpr double kTop = 1.2;    // camera to the layer's top, metres
+constexpr double kFloor = 1.35;  // camera to the floor
+
+// A camera looking straight down at a rectangular layer (its top a plane at
+// kTop, turned by yaw about the optical axis) on a floor. Exact depth.
+struct LayerFrame {
+  double width = 0.9, height = 0.4;  // layer outline, metres
+  double yaw_deg = 20.0;
+  Eigen::Vector2d centre{0.02, -0.03};
+  DepthImage image;
+
+  Eigen::Vector2d ToLayer(double x, double y) const {
+    const double c = std::cos(yaw_deg * M_PI / 180), s = std::sin(yaw_deg * M_PI / 180);
+    const Eigen::Vector2d d(x - centre.x(), y - centre.y());
+    return {c * d.x() + s * d.y(), -s * d.x() + c * d.y()};
+  }
+  Eigen::Vector3d FromLayer(double a, double b, double z) const {
+    const double c = std::cos(yaw_deg * M_PI / 180), s = std::sin(yaw_deg * M_PI / 180);
+    return {centre.x() + c * a - s * b, centre.y() + s * a + c * b, z};
+  }
+  void Render() {
+    image.camera = CameraIntrinsics{};
+    const CameraIntrinsics& k = image.camera;
+    image.z.assign(static_cast<size_t>(k.width) * k.height, 0.0f);
+    for (int v = 0; v < k.height; ++v) {
+      for (int u = 0; u < k.width; ++u) {
+        const Eigen::Vector3d ray = PixelRay(k, u, v);
+        const Eigen::Vector2d q = ToLayer(ray.x() * kTop, ray.y() * kTop);
+        const bool on_layer = std::abs(q.x()) <= width / 2 && std::abs(q.y()) <= height / 2;
+        image.z[static_cast<size_t>(v) * k.width + u] = static_cast<float>(on_layer ? kTop : kFloor);
+      }
+    }
+  }
+  // Grey image: cardboard (150) with dark seam lines (60) at the given
+  // layer coordinates, each line `px` pixels wide, and optional rectangles.
+  void Paint(const std::vector<double>& seams_a, const std::vector<double>& seams_b,
+             const std::vector<Eigen::Vector4d>& dark_rects = {}) {
+    const CameraIntrinsics& k = image.camera;
+    image.grey.assign(static_cast<size_t>(k.width) * k.height, 150.0f);
+    const double half_line = 0.002;  // 4 mm wide lines: ~2 px at 1.2 m
+    for (int v = 0; v < k.height; ++v) {
+      for (int u = 0; u < k.width; ++u) {
+        const Eigen::Vector3d ray = PixelRay(k, u, v);
+        const Eigen::Vector2d q = ToLayer(ray.x() * kTop, ray.y() * kTop);
+        float& g = image.grey[static_cast<size_t>(v) * k.width + u];
+        if (std::abs(q.x()) > width / 2 || std::abs(q.y()) > height / 2) {
+          g = 90.0f;  // the floor
+          continue;
+        }
+        for (double a : seams_a) {
+          if (std::abs(q.x() - a) < half_line) g = 60.0f;
+        }
+        for (double b : seams_b) {
+          if (std::abs(q.y() - b) < half_line) g = 60.0f;
+        }
+        for (const Eigen::Vector4d& r : dark_rects) {  // a0, b0, a1, b1
+          if (q.x() >= r[0] && q.x() <= r[2] && q.y() >= r[1] && q.y() <= r[3]) g = 40.0f;
+        }
+      }
+    }
+  }
+};
+
+const BoxDims kCarton{0.30, 0.20, 0.15};
+
+TEST(TilingsOfTest, AWholeNumberOfFacesAndFewestFirst) {
+  const FaceProposalOptions o;
+  // 3 x 2 cartons lying flat: 0.9 x 0.4.
+  std::vector<FaceTiling> t = TilingsOf(0.9 + 0.004, 0.4 + 0.002, kCarton, o);
+  ASSERT_FALSE(t.empty());
+  EXPECT_EQ(t[0].normal_axis, 2);
+  EXPECT_EQ(t[0].count_u, 3);
+  EXPECT_EQ(t[0].count_v, 2);
+  EXPECT_TRUE(t.size() == 1 || t[1].tiles() > t[0].tiles());
+  // One carton's top: one tile first (the 2 x 1 of side faces comes later).
+  t = TilingsOf(0.30, 0.20, kCarton, o);
+  ASSERT_GE(t.size(), 2u);
+  EXPECT_EQ(t[0].tiles(), 1);
+  EXPECT_GT(t[1].tiles(), 1);
+  // 0.6 x 0.6 tiles as 2 x 3 and as 3 x 2 cartons: two tilings, six each.
+  t = TilingsOf(0.6, 0.6, kCarton, o);
+  ASSERT_GE(t.size(), 2u);
+  EXPECT_EQ(t[0].tiles(), 6);
+  EXPECT_EQ(t[1].tiles(), 6);
+  // Nothing fits 0.45 x 0.25.
+  EXPECT_TRUE(TilingsOf(0.45, 0.25, kCarton, o).empty());
+}
+
+TEST(PlanarPatchesTest, TheLayerTopIsOnePatchOnItsPlane) {
+  LayerFrame f;
+  f.Render();
+  const PlanarPatches p = SegmentPlanarPatches(f.image, PlanarPatchOptions{});
+  ASSERT_GE(p.patches.size(), 1u);
+  int layer = p.PatchAt(320, 240);
+  ASSERT_GE(layer, 0);
+  const PlanarPatch& top = p.patches[layer];
+  EXPECT_NEAR(top.normal.z(), -1.0, 1e-3);
+  EXPECT_NEAR(top.centroid.z(), kTop, 1e-3);
+  const PlaneRectangle rect = OutlineRectangle(top);
+  const double w = std::max(rect.width, rect.height), h = std::min(rect.width, rect.height);
+  EXPECT_NEAR(w, f.width, 0.01);
+  EXPECT_NEAR(h, f.height, 0.01);
+}
+
+// Expects each pose to sit on one tile of the layer (tile centres at
+// (i + 0.5) size - outline / 2 in layer coordinates), and every tile hit.
+void ExpectTiles(const LayerFrame& f, const std::vector<Eigen::Isometry3d>& poses, double tile_a,
+                 double tile_b) {
+  const int na = static_cast<int>(std::lround(f.width / tile_a));
+  const int nb = static_cast<int>(std::lround(f.height / tile_b));
+  std::vector<int> hits(na * nb, 0);
+  for (const Eigen::Isometry3d& pose : poses) {
+    const Eigen::Vector3d c = pose.translation();
+    const Eigen::Vector2d q = f.ToLayer(c.x(), c.y());
+    const int i = static_cast<int>(std::floor((q.x() + f.width / 2) / tile_a));
+    const int j = static_cast<int>(std::floor((q.y() + f.height / 2) / tile_b));
+    ASSERT_TRUE(i >= 0 && i < na && j >= 0 && j < nb) << "pose off the layer";
+    EXPECT_NEAR(q.x(), -f.width / 2 + (i + 0.5) * tile_a, 0.01);
+    EXPECT_NEAR(q.y(), -f.height / 2 + (j + 0.5) * tile_b, 0.01);
+    EXPECT_NEAR(c.z(), kTop + 0.075, 0.005);  // the carton's centre, h / 2 below its top
+    ++hits[i * nb + j];
+  }
+  for (int h : hits) EXPECT_EQ(h, 1);
+}
+
+TEST(FaceProposalsTest, ALayerOfTouchingBoxesWithNoSeamsTilesIntoItsBoxes) {
+  LayerFrame f;  // 3 x 2 cartons, no seam in depth or colour
+  f.Render();
+  const FaceProposals p = ProposeFromFaces(f.image, kCarton, FaceProposalOptions{});
+  EXPECT_TRUE(p.declined.empty());
+  ASSERT_EQ(p.poses.size(), 6u);
+  ExpectTiles(f, p.poses, 0.30, 0.20);
+}
+
+TEST(FaceProposalsTest, ANotchedLayerProposesOnlyTheTilesThatAreThere) {
+  LayerFrame f;
+  f.width = 0.9;
+  f.height = 0.6;  // 3 x 3 cartons ...
+  f.Render();
+  // ... with one corner carton taken away: the floor shows there.
+  const CameraIntrinsics& k = f.image.camera;
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const Eigen::Vector3d ray = PixelRay(k, u, v);
+      const Eigen::Vector2d q = f.ToLayer(ray.x() * kTop, ray.y() * kTop);
+      if (q.x() > 0.15 && q.y() > 0.1) f.image.z[static_cast<size_t>(v) * k.width + u] = kFloor;
+    }
+  }
+  const FaceProposals p = ProposeFromFaces(f.image, kCarton, FaceProposalOptions{});
+  EXPECT_TRUE(p.declined.empty());
+  EXPECT_EQ(p.poses.size(), 8u);
+}
+
+TEST(FaceProposalsTest, TwoTilingsOfOneOutlineAreDeclinedWithoutASeamCue) {
+  LayerFrame f;
+  f.width = 0.6;
+  f.height = 0.6;  // 2 x 3 or 3 x 2 cartons
+  f.Render();
+  const FaceProposals p = ProposeFromFaces(f.image, kCarton, FaceProposalOptions{});
+  EXPECT_TRUE(p.poses.empty());
+  ASSERT_FALSE(p.declined.empty());
+  EXPECT_NE(p.declined[0].reason.find("tiles two ways"), std::string::npos) << p.declined[0].reason;
+}
+
+TEST(FaceProposalsTest, ColourSeamsDecideBetweenTwoTilings) {
+  LayerFrame f;
+  f.width = 0.6;
+  f.height = 0.6;
+  f.Render();
+  // Seams of 2 x 3 cartons with l along the layer's a axis: a line at a = 0
+  // and lines at b = -0.1, 0.1.
+  f.Paint({0.0}, {-0.1, 0.1});
+  const FaceProposals p = ProposeFromFaces(f.image, kCarton, FaceProposalOptions{});
+  EXPECT_TRUE(p.declined.empty());
+  ASSERT_EQ(p.poses.size(), 6u);
+  ExpectTiles(f, p.poses, 0.30, 0.20);
+  // The other way round: lines at a = -0.1, 0.1 and b = 0.
+  f.Paint({-0.1, 0.1}, {0.0});
+  const FaceProposals q = ProposeFromFaces(f.image, kCarton, FaceProposalOptions{});
+  ASSERT_EQ(q.poses.size(), 6u);
+  ExpectTiles(f, q.poses, 0.20, 0.30);
+}
+
+// The line along a = 0 across the whole layer, from b = -h/2 to h/2.
+SeamCue CueAtMiddle(const LayerFrame& f) {
+  return ColourSeamAlong(f.image, f.FromLayer(0.0, -f.height / 2, kTop),
+                         f.FromLayer(0.0, f.height / 2, kTop), f.FromLayer(1.0, 0.0, 0.0) -
+                                                                    f.FromLayer(0.0, 0.0, 0.0),
+                         SeamCueOptions{});
+}
+
+TEST(ColourSeamTest, ARealSeamRunningTheWholeSideIsASeam) {
+  LayerFrame f;
+  f.width = 0.6;
+  f.height = 0.2;
+  f.Render();
+  f.Paint({0.0}, {});
+  const SeamCue cue = CueAtMiddle(f);
+  EXPECT_TRUE(cue.seam);
+  EXPECT_GT(cue.coverage, 0.9);
+  EXPECT_NEAR(cue.offset_m, 0.0, 0.003);
+}
+
+TEST(ColourSeamTest, ALabelAcrossTheLineDoesNotMakeASeam) {
+  LayerFrame f;
+  f.width = 0.6;
+  f.height = 0.2;
+  f.Render();
+  // A dark label 8 x 6 cm straddling a = 0 (its edges cross the line), and
+  // a barcode-like block whose edge lies on the line over a third of it.
+  f.Paint({}, {}, {Eigen::Vector4d(-0.04, -0.08, 0.04, -0.02), Eigen::Vector4d(0.0, 0.02, 0.06, 0.085)});
+  const SeamCue cue = CueAtMiddle(f);
+  EXPECT_FALSE(cue.seam) << "coverage " << cue.coverage;
+  // Plain cardboard: nothing.
+  f.Paint({}, {});
+  EXPECT_FALSE(CueAtMiddle(f).seam);
+  // No colour at all: never a seam.
+  f.image.grey.clear();
+  EXPECT_FALSE(CueAtMiddle(f).seam);
+}
+
+TEST(FaceProposalOptionsTest, ValidateNamesTheField) {
+  FaceProposalOptions o;
+  EXPECT_TRUE(o.Validate().ok());
+  o.size_tolerance_m = -1;
+  EXPECT_NE(o.Validate().message().find("size_tolerance_m=-1"), std::string::npos);
+  o = {};
+  o.seams.min_coverage = 2;
+  EXPECT_NE(o.Validate().message().find("min_coverage=2"), std::string::npos);
+  o = {};
+  o.patches.step_px = 0;
+  EXPECT_NE(o.Validate().message().find("step_px=0"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cornerpose
