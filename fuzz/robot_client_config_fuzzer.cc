@@ -1,4 +1,4 @@
-// The robot-cell daemon's configuration file (robot_client/robot_config.h):
+// The robot-cell daemon's configuration file (robot_client/config/robot_config.h):
 // the text format parser (common/config), the conversion and Validate().
 #include <cstddef>
 #include <cstdint>

@@ -1,4 +1,4 @@
-// cornerpose_server's configuration file (server/server_config.h): the text
+// cornerpose_server's configuration file (server/config/server_config.h): the text
 // format parser (common/config) and every range check on the values.
 #include <cstddef>
 #include <cstdint>

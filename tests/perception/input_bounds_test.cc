@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "common/perception/box_models.h"
+#include "common/box/box_models.h"
 #include "common/perception/detector.h"
 #include "common/perception/edge_points.h"
 #include "tests/support/scene_generator.h"
