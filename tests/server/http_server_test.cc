@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 
+#include "server/http/http_server.h"
 #include "server/server.h"
 // After Eigen (through server.h): httplib.h pulls in <resolv.h>, whose _res
 // macro breaks Eigen's headers included after it.
@@ -210,6 +212,47 @@ TEST_F(HttpServerTest, BadHttpOptionsAreRefusedByName) {
   server = StartServer(options);
   ASSERT_FALSE(server.ok());
   EXPECT_NE(server.status().message().find("shoebox"), std::string::npos);
+}
+
+// HTTPS with the same PEM files as a gRPC TLS port: a certificate made at
+// test time with openssl, verified by the client.
+TEST(HttpsTest, ServesOverTlsWithTheGivenCertificate) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "http_tls";
+  fs::create_directories(dir);
+  const std::string cert = (dir / "cert.pem").string();
+  const std::string key = (dir / "key.pem").string();
+  const std::string command =
+      "openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=127.0.0.1 "
+      "-addext subjectAltName=IP:127.0.0.1 -keyout " + key + " -out " + cert + " 2>/dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+
+  DetectionPool pool(1);
+  const BoxModels models;
+  HttpOptions options;
+  options.listen_address = "127.0.0.1:0";
+  absl::StatusOr<std::unique_ptr<HttpServer>> server =
+      HttpServer::Start(options, {cert, key}, {}, &pool, DetectorOptions{}, &models, nullptr);
+  ASSERT_TRUE(server.ok()) << server.status();
+
+  httplib::SSLClient client("127.0.0.1", (*server)->port());
+  client.set_ca_cert_path(cert.c_str());
+  client.enable_server_certificate_verification(true);
+  httplib::Result res = client.Get("/api/sources");
+  ASSERT_TRUE(res) << httplib::to_string(res.error());
+  EXPECT_EQ(res->status, 200);
+  EXPECT_EQ(res->body, R"({"sources":[]})");
+  // Plain HTTP to the HTTPS port gets no answer.
+  httplib::Client plain("127.0.0.1", (*server)->port());
+  plain.set_read_timeout(5, 0);
+  httplib::Result refused = plain.Get("/api/sources");
+  EXPECT_TRUE(!refused || refused->status != 200);
+
+  // A key that is not a key: refused at start, naming the files.
+  absl::StatusOr<std::unique_ptr<HttpServer>> bad =
+      HttpServer::Start(options, {cert, cert}, {}, &pool, DetectorOptions{}, &models, nullptr);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_NE(bad.status().message().find("cert.pem"), std::string::npos);
 }
 
 // A value in the exposition text: the line "NAME{LABELS} VALUE" (0 when absent).
