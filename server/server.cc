@@ -17,10 +17,14 @@ namespace cornerpose::server {
 
 RunningServer::RunningServer(std::unique_ptr<DetectionPool> pool,
                              std::unique_ptr<PerceptionServiceImpl> service,
-                             std::unique_ptr<grpc::Server> server, int port)
+                             std::unique_ptr<grpc::Server> server, int port,
+                             std::unique_ptr<ServerMetrics> metrics,
+                             std::unique_ptr<HttpServer> http)
     : pool_(std::move(pool)),
+      metrics_(std::move(metrics)),
       service_(std::move(service)),
       server_(std::move(server)),
+      http_(std::move(http)),
       port_(port) {}
 
 RunningServer::~RunningServer() { Shutdown(); }
@@ -28,6 +32,7 @@ RunningServer::~RunningServer() { Shutdown(); }
 void RunningServer::Shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
+  if (http_ != nullptr) http_->Shutdown();
   service_->StopStreams();
   server_->Shutdown();
 }
@@ -68,7 +73,22 @@ absl::StatusOr<std::unique_ptr<RunningServer>> StartServer(const ServerOptions& 
     grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   });
 
+  if (!options.http.listen_address.empty()) {
+    if (absl::Status s = options.http.Validate(); !s.ok()) return s;
+  }
+
   auto pool = std::make_unique<DetectionPool>(options.max_concurrent_detections);
+  auto metrics = std::make_unique<ServerMetrics>();
+  DetectionPool* pool_ptr = pool.get();
+  if (absl::Status s = metrics->registry().AddGaugeCallback(
+          "cornerpose_detection_queue_depth", "Detections waiting for a worker", {},
+          [pool_ptr] {
+            return std::vector<std::pair<cornerpose::metrics::LabelValues, double>>{
+                {{}, static_cast<double>(pool_ptr->queue_depth())}};
+          });
+      !s.ok()) {
+    return s;
+  }
   // Started before the server so the first frames are loading while it
   // binds; a source that fails is listed as FAILED rather than refusing to
   // start (one bad recording should not take down the others).
@@ -88,14 +108,28 @@ absl::StatusOr<std::unique_ptr<RunningServer>> StartServer(const ServerOptions& 
                                std::numeric_limits<int>::max());
   }
   builder.RegisterService(service.get());
+  std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
+  interceptors.push_back(metrics->MakeInterceptorFactory());
+  builder.experimental().SetInterceptorCreators(std::move(interceptors));
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   if (server == nullptr || port == 0) {
     if (server != nullptr) server->Shutdown();
     return absl::UnavailableError(absl::StrCat("could not listen on '", options.listen_address,
                                                "' (address in use or malformed?)"));
   }
+  std::unique_ptr<HttpServer> http;
+  if (!options.http.listen_address.empty()) {
+    absl::StatusOr<std::unique_ptr<HttpServer>> started =
+        HttpServer::Start(options.http, HttpTls{}, service->sources(), pool.get(),
+                          options.detector, &service->box_models(), metrics.get());
+    if (!started.ok()) {
+      server->Shutdown();
+      return started.status();
+    }
+    http = *std::move(started);
+  }
   return std::make_unique<RunningServer>(std::move(pool), std::move(service), std::move(server),
-                                         port);
+                                         port, std::move(metrics), std::move(http));
 }
 
 }  // namespace cornerpose::server

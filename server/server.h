@@ -9,6 +9,8 @@
 
 #include "absl/status/statusor.h"
 #include "server/config/server_options.h"
+#include "server/http/http_server.h"
+#include "server/metrics/server_metrics.h"
 #include "server/service/detection_pool.h"
 #include "server/service/perception_service.h"
 
@@ -18,7 +20,9 @@ namespace cornerpose::server {
 class RunningServer {
  public:
   RunningServer(std::unique_ptr<DetectionPool> pool, std::unique_ptr<PerceptionServiceImpl> service,
-                std::unique_ptr<grpc::Server> server, int port);
+                std::unique_ptr<grpc::Server> server, int port,
+                std::unique_ptr<ServerMetrics> metrics = nullptr,
+                std::unique_ptr<HttpServer> http = nullptr);
   ~RunningServer();
 
   RunningServer(const RunningServer&) = delete;
@@ -27,6 +31,8 @@ class RunningServer {
   // The port bound (the chosen one when the address asked for port 0).
   int port() const { return port_; }
   grpc::Server& grpc_server() { return *server_; }
+  // The HTTP port bound (web view, JSON API, /metrics); 0 when it is off.
+  int http_port() const { return http_ != nullptr ? http_->port() : 0; }
 
   // Stops accepting RPCs and waits for those in flight. Idempotent.
   void Shutdown();
@@ -36,16 +42,21 @@ class RunningServer {
  private:
   // Destroyed in reverse order: the server (already shut down) before the
   // service it calls, and both before the pool the service submits to.
+  // The metrics before the servers that count into them; the HTTP port
+  // (whose views use the pool and the sources) first of all.
   std::unique_ptr<DetectionPool> pool_;
+  std::unique_ptr<ServerMetrics> metrics_;
   std::unique_ptr<PerceptionServiceImpl> service_;
   std::unique_ptr<grpc::Server> server_;
+  std::unique_ptr<HttpServer> http_;
   int port_;
   bool shut_down_ = false;
 };
 
-// Binds options.listen_address with health checking and reflection enabled.
-// INVALID_ARGUMENT for bad options; UNAVAILABLE when the address cannot be
-// bound.
+// Binds options.listen_address with health checking and reflection enabled,
+// and options.http.listen_address (unless empty) for the web view and
+// /metrics. INVALID_ARGUMENT for bad options; UNAVAILABLE when an address
+// cannot be bound.
 absl::StatusOr<std::unique_ptr<RunningServer>> StartServer(const ServerOptions& options);
 
 }  // namespace cornerpose::server

@@ -22,9 +22,11 @@
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
 #include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
 #include "absl/strings/strip.h"
+#include "common/logging/log.h"
 #include "server/config/server_config.h"
 #include "server/config/server_options.h"
 #include "server/server.h"
@@ -43,6 +45,14 @@ ABSL_FLAG(int, max_concurrent_detections,
 ABSL_FLAG(int, max_connection_age_s, cornerpose::server::ServerOptions{}.max_connection_age_s,
           "ask connections older than this many seconds to reconnect (clients then re-resolve "
           "the name and reach new replicas; calls in flight are not cut); 0 = never");
+ABSL_FLAG(std::string, http_listen, cornerpose::server::kDefaultHttpListen,
+          "host:port of the HTTP port: the web view, its JSON API and /metrics (port 0 picks "
+          "a free one; empty turns it off)");
+ABSL_FLAG(std::string, cell_status_address, "",
+          "host:port of the robot-cell daemon's status service, shown by the web view");
+ABSL_FLAG(std::string, view_box, cornerpose::server::HttpOptions{}.view_box,
+          "the box the web view detects when the page names none (model name or L,B,H)");
+ABSL_FLAG(std::string, log_format, "text", "log lines as text or json (one object per line)");
 ABSL_FLAG(std::vector<std::string>, source, {},
           "a frame source: NAME=DIR[:FPS[:loop|once]] (recorded frames, default 5 fps, loop), "
           "NAME=openni2:[URI] (an OpenNI2 camera; empty URI = any), or "
@@ -113,6 +123,19 @@ int main(int argc, char** argv) {
   absl::SetProgramUsageMessage("Serves cornerpose.v1.PerceptionService over gRPC.");
   const std::vector<std::string> source_flags = AllSourceFlags(argc, argv);
   absl::ParseCommandLine(argc, argv);
+  namespace logging = cornerpose::logging;
+  absl::StatusOr<logging::LogFormat> log_format =
+      logging::ParseLogFormat(absl::GetFlag(FLAGS_log_format));
+  if (!log_format.ok()) {
+    std::cerr << "cornerpose_server: --log_format: " << log_format.status() << "\n";
+    return 2;
+  }
+  logging::SetLogFormat(*log_format);
+  const auto fail = [](const absl::Status& status) {
+    logging::Log(logging::LogLevel::kError, "server", "cannot start",
+                 {{"error", std::string(status.ToString())}});
+    return 1;
+  };
 
   sem_init(&stop_requested, /*pshared=*/0, /*value=*/0);
   struct sigaction action = {};
@@ -126,10 +149,7 @@ int main(int argc, char** argv) {
   if (!config.empty()) {
     absl::StatusOr<cornerpose::server::ServerOptions> loaded =
         cornerpose::server::LoadServerConfig(config);
-    if (!loaded.ok()) {
-      std::cerr << "cornerpose_server: " << loaded.status() << "\n";
-      return 1;
-    }
+    if (!loaded.ok()) return fail(loaded.status());
     options = *std::move(loaded);
   }
   // Without a file every flag applies (its default matches ServerOptions').
@@ -146,27 +166,42 @@ int main(int argc, char** argv) {
   if (given("max_connection_age_s")) {
     options.max_connection_age_s = absl::GetFlag(FLAGS_max_connection_age_s);
   }
+  if (given("http_listen")) options.http.listen_address = absl::GetFlag(FLAGS_http_listen);
+  if (given("cell_status_address")) {
+    options.http.cell_status_address = absl::GetFlag(FLAGS_cell_status_address);
+  }
+  if (given("view_box")) options.http.view_box = absl::GetFlag(FLAGS_view_box);
   if (!source_flags.empty()) options.sources.clear();
   for (const std::string& text : source_flags) {
     absl::StatusOr<cornerpose::server::SourceSpec> spec = cornerpose::server::ParseSourceSpec(text);
-    if (!spec.ok()) {
-      std::cerr << "cornerpose_server: " << spec.status() << "\n";
-      return 1;
-    }
+    if (!spec.ok()) return fail(spec.status());
     options.sources.push_back(*std::move(spec));
   }
 
   auto server = cornerpose::server::StartServer(options);
-  if (!server.ok()) {
-    std::cerr << "cornerpose_server: " << server.status() << "\n";
-    return 1;
+  if (!server.ok()) return fail(server.status());
+  // "listening on A (port N)": what scripts and tests look for in either format.
+  logging::Log(logging::LogLevel::kInfo, "server",
+               absl::StrCat("listening on ", options.listen_address, " (port ", (*server)->port(),
+                            ")"),
+               {{"address", options.listen_address}, {"port", (*server)->port()}});
+  if ((*server)->http_port() != 0) {
+    logging::Log(logging::LogLevel::kInfo, "server",
+                 absl::StrCat("http listening on ", options.http.listen_address, " (port ",
+                              (*server)->http_port(), ")"),
+                 {{"address", options.http.listen_address}, {"port", (*server)->http_port()}});
   }
-  std::cerr << "cornerpose_server: listening on " << options.listen_address << " (port "
-            << (*server)->port() << ")" << std::endl;
+  for (const cornerpose::server::SourceSpec& spec : options.sources) {
+    logging::Log(logging::LogLevel::kInfo, "server", "source",
+                 {{"name", spec.name},
+                  {"where", spec.kind == cornerpose::server::SourceKind::kDirectory ? spec.directory
+                                                                                  : spec.uri}});
+  }
 
   while (sem_wait(&stop_requested) != 0 && errno == EINTR) {
   }
-  std::cerr << "cornerpose_server: signal " << stop_signal << ", shutting down" << std::endl;
+  logging::Log(logging::LogLevel::kInfo, "server", "shutting down",
+               {{"signal", static_cast<int>(stop_signal)}});
   (*server)->Shutdown();
   return 0;
 }

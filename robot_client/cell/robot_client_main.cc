@@ -12,6 +12,7 @@
 #include <semaphore.h>
 
 #include <csignal>
+#include <memory>
 #include <cstdio>
 #include <string>
 #include <thread>
@@ -22,10 +23,13 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "common/logging/log.h"
+#include "common/metrics/metrics_http.h"
 #include "robot_client/cell/cell_controller.h"
 #include "robot_client/cell/perception_subscriber.h"
 #include "robot_client/cell/status_service.h"
 #include "robot_client/config/robot_config.h"
+#include "robot_client/metrics/daemon_metrics.h"
 
 ABSL_FLAG(std::string, config, "",
           "the configuration file (cornerpose.v1.RobotClientConfig, protobuf text format); "
@@ -40,6 +44,10 @@ ABSL_FLAG(std::string, status_listen, "",
           "host:port of the status service (overrides the file; port 0 picks one)");
 ABSL_FLAG(bool, dry_run, false, "print the programs instead of sending them");
 ABSL_FLAG(int, max_picks, -1, "stop after this many picks (overrides the file; 0 = no limit)");
+ABSL_FLAG(std::string, metrics_listen, "127.0.0.1:9108",
+          "host:port of the daemon's Prometheus /metrics (port 0 picks one; empty turns it off)");
+ABSL_FLAG(std::string, log_format, "text",
+          "text (one readable line per pick and state change) or json (one object per line)");
 
 namespace {
 
@@ -52,6 +60,26 @@ std::string Timestamp() {
   return absl::FormatTime("%H:%M:%E3S", absl::Now(), absl::LocalTimeZone());
 }
 
+namespace logging = cornerpose::logging;
+
+bool JsonLogs() { return logging::GetLogFormat() == logging::LogFormat::kJson; }
+
+// A line for operators: printed as is in text mode (the per-pick lines keep
+// their layout), one JSON object in json mode.
+void Note(const std::string& message, std::initializer_list<logging::Field> fields = {}) {
+  if (JsonLogs()) {
+    logging::Log(logging::LogLevel::kInfo, "cell", message, fields);
+    return;
+  }
+  std::printf("%s %s\n", Timestamp().c_str(), message.c_str());
+  std::fflush(stdout);
+}
+
+int Fail(const std::string& message) {
+  logging::Log(logging::LogLevel::kError, "cell", message);
+  return 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -59,16 +87,21 @@ int main(int argc, char** argv) {
   absl::SetProgramUsageMessage(
       "The robot-cell daemon: detections in, URScript pick-and-place programs out.");
   absl::ParseCommandLine(argc, argv);
+  absl::StatusOr<logging::LogFormat> log_format =
+      logging::ParseLogFormat(absl::GetFlag(FLAGS_log_format));
+  if (!log_format.ok()) {
+    std::fprintf(stderr, "cornerpose_robot_client: --log_format: %s\n",
+                 log_format.status().ToString().c_str());
+    return 2;
+  }
+  logging::SetLogFormat(*log_format);
   const std::string config = absl::GetFlag(FLAGS_config);
   if (config.empty()) {
-    std::fprintf(stderr, "cornerpose_robot_client: --config FILE is required\n");
+    Fail("--config FILE is required");
     return 2;
   }
   absl::StatusOr<RobotClientOptions> loaded = LoadRobotClientConfig(config);
-  if (!loaded.ok()) {
-    std::fprintf(stderr, "cornerpose_robot_client: %s\n", loaded.status().ToString().c_str());
-    return 1;
-  }
+  if (!loaded.ok()) return Fail(loaded.status().ToString());
   RobotClientOptions options = *std::move(loaded);
   if (const std::string v = absl::GetFlag(FLAGS_server); !v.empty()) {
     options.perception.server_address = v;
@@ -83,10 +116,7 @@ int main(int argc, char** argv) {
   }
   if (absl::GetFlag(FLAGS_dry_run)) options.dry_run = true;
   if (const int v = absl::GetFlag(FLAGS_max_picks); v >= 0) options.max_picks = v;
-  if (absl::Status s = options.Validate(); !s.ok()) {
-    std::fprintf(stderr, "cornerpose_robot_client: %s\n", s.ToString().c_str());
-    return 1;
-  }
+  if (absl::Status s = options.Validate(); !s.ok()) return Fail(s.ToString());
 
   sem_init(&stop_requested, /*pshared=*/0, /*value=*/0);
   struct sigaction action = {};
@@ -104,20 +134,40 @@ int main(int argc, char** argv) {
   perception.max_backoff = absl::Seconds(options.perception.reconnect_max_s);
   PerceptionSubscriber subscriber(perception);
 
+  // Set once the cell exists (its status feeds the sampler).
+  std::unique_ptr<DaemonMetrics> metrics;
   CellCallbacks callbacks;
-  callbacks.on_pick = [](const PickRecord& pick) {
+  callbacks.on_pick = [&metrics](const PickRecord& pick) {
+    if (metrics != nullptr) metrics->OnPick(pick);
+    if (JsonLogs()) {
+      const Eigen::Vector3d box = pick.plan.box.base_T_box.translation();
+      logging::Log(pick.outcome == PickOutcome::kCompleted || pick.outcome == PickOutcome::kDryRun
+                       ? logging::LogLevel::kInfo
+                       : logging::LogLevel::kWarning,
+                   "cell", "pick",
+                   {{"pick_id", pick.pick_id},
+                    {"outcome", PickOutcomeName(pick.outcome)},
+                    {"source", pick.source},
+                    {"frame_id", pick.frame_id},
+                    {"score", pick.score},
+                    {"box_x", box.x()},
+                    {"box_y", box.y()},
+                    {"box_z", box.z()},
+                    {"slot", pick.plan.slot},
+                    {"plan_ms", pick.plan_ms},
+                    {"program_s", pick.program_s},
+                    {"detail", pick.detail}});
+      return;
+    }
     std::printf("%s %s\n", Timestamp().c_str(), DescribePick(pick).c_str());
     std::fflush(stdout);
   };
   callbacks.on_state = [](const CellStatusSnapshot& status) {
-    std::printf("%s cell %s%s%s\n", Timestamp().c_str(), CellStateName(status.state),
-                status.stop_reason.empty() ? "" : ": ", status.stop_reason.c_str());
-    std::fflush(stdout);
+    Note(absl::StrCat("cell ", CellStateName(status.state), status.stop_reason.empty() ? "" : ": ",
+                      status.stop_reason),
+         {{"state", CellStateName(status.state)}, {"stop_reason", status.stop_reason}});
   };
-  callbacks.on_note = [](const std::string& note) {
-    std::printf("%s %s\n", Timestamp().c_str(), note.c_str());
-    std::fflush(stdout);
-  };
+  callbacks.on_note = [](const std::string& note) { Note(note); };
   const bool dry_run = options.dry_run;
   callbacks.on_program = [dry_run](const std::string& name, const std::string& text) {
     if (!dry_run) return;
@@ -126,19 +176,31 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   };
   const std::string status_address = options.status_listen_address;
-  std::printf("%s cornerpose_robot_client: perception %s source '%s', robot %s (%s), %s\n",
-              Timestamp().c_str(), options.perception.server_address.c_str(),
-              options.perception.source.c_str(), options.robot.host.c_str(),
-              dry_run ? "dry run" : "live", status_address.c_str());
+  Note(absl::StrCat("cornerpose_robot_client: perception ", options.perception.server_address,
+                    " source '", options.perception.source, "', robot ", options.robot.host, " (",
+                    dry_run ? "dry run" : "live", "), ", status_address),
+       {{"perception", options.perception.server_address},
+        {"source", options.perception.source},
+        {"robot", options.robot.host},
+        {"dry_run", dry_run},
+        {"status_listen", status_address}});
   CellController cell(std::move(options), CellControllerOptions{}, &subscriber, callbacks);
 
   absl::StatusOr<std::unique_ptr<StatusServer>> status = StartStatusServer(status_address, &cell);
-  if (!status.ok()) {
-    std::fprintf(stderr, "cornerpose_robot_client: %s\n", status.status().ToString().c_str());
-    return 1;
+  if (!status.ok()) return Fail(status.status().ToString());
+  Note(absl::StrCat("status service on port ", (*status)->port()), {{"port", (*status)->port()}});
+
+  metrics = std::make_unique<DaemonMetrics>([&cell, &subscriber] {
+    return DaemonMetrics::Sample{cell.Status(), subscriber.frames_received()};
+  });
+  std::unique_ptr<cornerpose::metrics::MetricsHttpServer> metrics_http;
+  if (const std::string listen = absl::GetFlag(FLAGS_metrics_listen); !listen.empty()) {
+    absl::StatusOr<std::unique_ptr<cornerpose::metrics::MetricsHttpServer>> started =
+        cornerpose::metrics::MetricsHttpServer::Start(listen, &metrics->registry());
+    if (!started.ok()) return Fail(started.status().ToString());
+    metrics_http = *std::move(started);
+    Note(absl::StrCat("metrics on port ", metrics_http->port()), {{"port", metrics_http->port()}});
   }
-  std::printf("%s status service on port %d\n", Timestamp().c_str(), (*status)->port());
-  std::fflush(stdout);
 
   // The signal thread stops the cell; a finished cell wakes it through the
   // same semaphore.
@@ -153,8 +215,10 @@ int main(int argc, char** argv) {
   sem_post(&stop_requested);
   stopper.join();
   (*status)->Shutdown();
+  if (metrics_http != nullptr) metrics_http->Shutdown();
   const CellStatusSnapshot end = cell.Status();
-  std::printf("%s stopped: %d picks done, %d failed\n", Timestamp().c_str(), end.picks_done,
-              end.picks_failed);
+  Note(absl::StrCat("stopped: ", end.picks_done, " picks done, ", end.picks_failed, " failed"),
+       {{"picks_done", end.picks_done}, {"picks_failed", end.picks_failed}});
+  metrics.reset();  // its sampler reads the cell
   return 0;
 }

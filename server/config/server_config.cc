@@ -56,6 +56,11 @@ absl::StatusOr<ServerOptions> LoadServerConfig(const std::string& path) {
     options.max_connection_age_s = config.max_connection_age_s();
   }
 
+  options.http.listen_address =
+      config.has_http_listen() ? config.http_listen() : std::string(kDefaultHttpListen);
+  options.http.cell_status_address = config.cell_status_address();
+  if (!config.view_box().empty()) options.http.view_box = config.view_box();
+
   const std::filesystem::path base = std::filesystem::path(path).parent_path();
   std::set<std::string> names;
   for (int i = 0; i < config.sources_size(); ++i) {

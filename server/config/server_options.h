@@ -7,6 +7,7 @@
 
 #include "common/box/box_models.h"
 #include "common/perception/detector.h"
+#include "server/http/http_options.h"
 
 namespace cornerpose::server {
 
@@ -63,6 +64,8 @@ struct ServerOptions {
   // Frame sources requests can name. A source that fails (a missing
   // directory, say) is listed as FAILED; the server still starts.
   std::vector<SourceSpec> sources;
+  // The HTTP port: the web view, its JSON API and /metrics (http_options.h).
+  HttpOptions http;
 };
 
 }  // namespace cornerpose::server

@@ -28,6 +28,11 @@ void DetectionPool::Submit(std::function<void()> task) {
   ready_.notify_one();
 }
 
+int DetectionPool::queue_depth() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return static_cast<int>(queue_.size());
+}
+
 void DetectionPool::WorkerLoop() {
   for (;;) {
     std::function<void()> task;

@@ -25,11 +25,13 @@ class DetectionPool {
 
   // Queues a task; it runs on a worker when one is free.
   void Submit(std::function<void()> task);
+  // Tasks waiting for a worker (not those running); for /metrics.
+  int queue_depth() const;
 
  private:
   void WorkerLoop();
 
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable ready_;
   std::deque<std::function<void()>> queue_;  // guarded by mutex_
   bool stopping_ = false;                    // guarded by mutex_

@@ -44,6 +44,15 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
   // flight, calls this first.
   void StopStreams() { stopping_streams_ = true; }
 
+  // The server's own box models (the web view resolves its boxes with them).
+  const BoxModels& box_models() const { return box_models_; }
+  // The sources requests can name, by name (the web view shows them too).
+  std::vector<FrameSource*> sources() const {
+    std::vector<FrameSource*> out;
+    for (const auto& [name, source] : sources_) out.push_back(source.get());
+    return out;
+  }
+
  private:
   DetectionPool* pool_;
   const DetectorOptions defaults_;

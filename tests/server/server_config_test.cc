@@ -67,6 +67,8 @@ TEST(ServerConfigTest, EveryDeployConfigStartsAServerWithItsSources) {
     ASSERT_TRUE(options.ok()) << options.status();
     ASSERT_FALSE(options->sources.empty());
     options->listen_address = "127.0.0.1:0";
+    // The file's HTTP port, on a free port (tests run in parallel).
+    if (!options->http.listen_address.empty()) options->http.listen_address = "127.0.0.1:0";
     absl::StatusOr<std::unique_ptr<RunningServer>> server = StartServer(*options);
     ASSERT_TRUE(server.ok()) << server.status();
     auto stub = v1::PerceptionService::NewStub(grpc::CreateChannel(
@@ -186,11 +188,25 @@ TEST(ServerConfigTest, UnsetFieldsTakeServerOptionsDefaults) {
   EXPECT_EQ(options->max_message_bytes, defaults.max_message_bytes);
   EXPECT_EQ(options->max_concurrent_detections, defaults.max_concurrent_detections);
   EXPECT_EQ(options->max_connection_age_s, 0);
+  EXPECT_EQ(options->http.listen_address, kDefaultHttpListen);
+  EXPECT_EQ(options->http.cell_status_address, "");
+  EXPECT_EQ(options->http.view_box, HttpOptions{}.view_box);
   ASSERT_EQ(options->sources.size(), 1u);
   EXPECT_EQ(options->sources[0].fps, SourceSpec{}.fps);
   EXPECT_TRUE(options->sources[0].loop);
   // Relative to the file's directory.
   EXPECT_EQ(options->sources[0].directory, (fs::path(path).parent_path() / "frames").string());
+}
+
+TEST(ServerConfigTest, HttpFieldsAreRead) {
+  const std::string path = WriteConfig(
+      "http.textproto",
+      "http_listen: \"\"\ncell_status_address: \"10.0.0.5:50061\"\nview_box: \"brick\"\n");
+  const absl::StatusOr<ServerOptions> options = LoadServerConfig(path);
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(options->http.listen_address, "");  // set empty: no HTTP port
+  EXPECT_EQ(options->http.cell_status_address, "10.0.0.5:50061");
+  EXPECT_EQ(options->http.view_box, "brick");
 }
 
 }  // namespace

@@ -48,7 +48,9 @@ class RunningServer:
     """A cornerpose_server process; its gRPC address and its stderr so far."""
 
     def __init__(self, binary: pathlib.Path, args):
-        self.process = subprocess.Popen([str(binary), "--listen", "127.0.0.1:0", *args],
+        # A free HTTP port too: tests run in parallel (the default is 8080).
+        self.process = subprocess.Popen([str(binary), "--listen", "127.0.0.1:0",
+                                         "--http_listen", "127.0.0.1:0", *args],
                                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                         text=True)
         self.log = []
@@ -70,7 +72,7 @@ class RunningServer:
                 pytest.fail("cornerpose_server printed no port within 60 s:\n" + "".join(self.log))
             if line == "":
                 pytest.fail("cornerpose_server exited:\n" + "".join(self.log))
-            match = re.search(r"listening on .*\(port (\d+)\)", line)
+            match = re.search(r"(?<!http )listening on .*\(port (\d+)\)", line)
             if match:
                 self.port = int(match.group(1))
                 break
