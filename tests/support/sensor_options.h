@@ -92,7 +92,8 @@ struct TofOptions {
   double multipath_gain = 1.0;
   double multipath_radius_m = 0.15;
   // 3. Noise from the return's strength: amplitude a = albedo cos(theta) /
-  // z^2 (albedo of the surface in IR), sigma_z = sigma_ref_m *
+  // r^2 cos(phi)^3 (albedo of the surface in IR, phi the angle off the
+  // illuminator's axis), sigma_z = sigma_ref_m *
   // sqrt(a_ref / a), a_ref = 0.5 at 1 m, head on. Below min_amplitude the
   // pixel is invalid. sigma m [0, 0.05]; min_amplitude [0, 1].
   double sigma_ref_m = 0.0015;

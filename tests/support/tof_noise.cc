@@ -22,10 +22,11 @@ enum Status : uint8_t { kValid, kNoReturn, kWeak, kDropout };
 // concrete are brighter in the NIR than they look; black print stays dark.
 double InfraredAlbedo(double luma) { return std::clamp(1.6 * luma, 0.02, 0.95); }
 
-// Returned amplitude, relative: albedo cos(theta) / z^2 (radial distance).
+// Returned amplitude, relative: albedo cos(theta) / r^2 (r the radial
+// distance), times the illuminator's beam falloff cos(off-axis angle)^3.
 double Amplitude(double albedo, const Eigen::Vector3d& normal, const Eigen::Vector3d& p) {
-  const double r = p.norm();
-  return albedo * std::max(0.0, -normal.dot(p) / r) / (r * r);
+  const double r = p.norm(), beam = p.z() / r;
+  return albedo * std::max(0.0, -normal.dot(p) / r) / (r * r) * beam * beam * beam;
 }
 
 }  // namespace
