@@ -18,6 +18,10 @@ absl::Status EvidenceOptions::Validate() const {
     return absl::InvalidArgumentError(absl::StrCat(
         "depth_tolerance_per_m2=", depth_tolerance_per_m2, " is outside [0, 0.2] 1/m"));
   }
+  if (!(outline_margin_m >= 0.0 && outline_margin_m <= 0.1)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("outline_margin_m=", outline_margin_m, " is outside [0, 0.1] m"));
+  }
   if (max_samples < 10 || max_samples > 10000000) {
     return absl::InvalidArgumentError(
         absl::StrCat("evidence max_samples=", max_samples, " is outside [10, 1e7]"));
@@ -47,43 +51,68 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
   const Eigen::Matrix3d box_R_camera = camera_T_box.linear().transpose();
   const Eigen::Vector3d origin = -(box_R_camera * camera_T_box.translation());
   const Eigen::Vector3d half = 0.5 * dims.vec();
+  // The ray through pixel (u, v) enters the box at depth *t through face
+  // *face; false when it misses.
+  auto cast = [&](double u, double v, double* t, int* face) {
+    const Eigen::Vector3d dir = box_R_camera * PixelRay(k, u, v);
+    double t_near = -std::numeric_limits<double>::max(),
+           t_far = std::numeric_limits<double>::max();
+    int near_axis = -1;
+    for (int a = 0; a < 3; ++a) {
+      if (std::abs(dir[a]) < 1e-12) {
+        if (std::abs(origin[a]) > half[a]) return false;
+        continue;
+      }
+      double t1 = (-half[a] - origin[a]) / dir[a], t2 = (half[a] - origin[a]) / dir[a];
+      if (t1 > t2) std::swap(t1, t2);
+      if (t1 > t_near) {
+        t_near = t1;
+        near_axis = a;
+      }
+      t_far = std::min(t_far, t2);
+      if (t_near > t_far) return false;
+    }
+    if (near_axis < 0 || t_near <= 0.0) return false;
+    *t = t_near;  // rays have unit z
+    // The ray enters through the face on the side it comes from.
+    *face = 2 * near_axis + (dir[near_axis] < 0.0 ? 0 : 1);
+    return true;
+  };
+  // The outline margin in pixels at the box's depth.
+  const double margin_px =
+      options.outline_margin_m > 0.0
+          ? std::max(1.0, options.outline_margin_m * k.fx / camera_T_box.translation().z())
+          : 0.0;
+  auto near_outline = [&](int u, int v) {
+    if (margin_px <= 0.0) return false;
+    double t;
+    int face;
+    for (const auto& [du, dv] : {std::pair{1.0, 0.0}, std::pair{-1.0, 0.0}, std::pair{0.0, 1.0},
+                                 std::pair{0.0, -1.0}}) {
+      if (!cast(u + du * margin_px, v + dv * margin_px, &t, &face)) return true;
+    }
+    return false;
+  };
   std::array<int, 6> face_px{};
   for (int v = va; v <= vb; v += step) {
     for (int u = ua; u <= ub; u += step) {
-      const Eigen::Vector3d dir = box_R_camera * PixelRay(k, u, v);
-      double t_near = -std::numeric_limits<double>::max(),
-             t_far = std::numeric_limits<double>::max();
-      int near_axis = -1;
-      bool hit = true;
-      for (int a = 0; a < 3 && hit; ++a) {
-        if (std::abs(dir[a]) < 1e-12) {
-          hit = std::abs(origin[a]) <= half[a];
-          continue;
-        }
-        double t1 = (-half[a] - origin[a]) / dir[a], t2 = (half[a] - origin[a]) / dir[a];
-        if (t1 > t2) std::swap(t1, t2);
-        if (t1 > t_near) {
-          t_near = t1;
-          near_axis = a;
-        }
-        t_far = std::min(t_far, t2);
-        hit = t_near <= t_far;
-      }
-      if (!hit || near_axis < 0 || t_near <= 0.0) continue;
-      // The ray enters through the face on the side it comes from.
-      const int face = 2 * near_axis + (dir[near_axis] < 0.0 ? 0 : 1);
+      double z_model;
+      int face;
+      if (!cast(u, v, &z_model, &face)) continue;
       FaceEvidence& f = ev.faces[face];
       ++face_px[face];
-      ++f.expected;
-      const double z_model = t_near;  // rays have unit z
       const float z = depth.at(u, v);
-      if (std::isnan(z)) {
-        ++f.missing;
-        continue;
-      }
       const double tol =
           options.depth_tolerance_base_m + options.depth_tolerance_per_m2 * z_model * z_model;
-      if (z < z_model - tol) {
+      const bool disagrees = std::isnan(z) || z > z_model + tol;
+      if (disagrees && near_outline(u, v)) {
+        ++f.border;
+        continue;
+      }
+      ++f.expected;
+      if (std::isnan(z)) {
+        ++f.missing;
+      } else if (z < z_model - tol) {
         ++f.occluded;
       } else if (z > z_model + tol) {
         ++f.see_through;
@@ -101,6 +130,7 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
     t.occluded += ev.faces[f].occluded;
     t.see_through += ev.faces[f].see_through;
     t.missing += ev.faces[f].missing;
+    t.border += ev.faces[f].border;
   }
   ev.grasp_face = static_cast<BoxFace>(best);
   return ev;

@@ -18,6 +18,15 @@ struct EvidenceOptions {
   double depth_tolerance_per_m2 = 0.004;
   // At most this many pixels are tested per box (a regular subsample). Count.
   int max_samples = 3000;
+  // Pixels within this distance of the box's projected outline that do not
+  // agree (seen through or no return) are counted as `border`, not against
+  // the box: stereo edge fattening, flying and mixed pixels between a box
+  // and what lies behind it, and a real box a little off its nominal size
+  // all live there. Metres on the box, turned into pixels at the box's depth
+  // (fx / z), at least one pixel. DetectBoxes sets it to half the edge
+  // radius r_s (the scale at which the edge detector resolves an outline).
+  // [0, 0.1]; 0 counts every pixel.
+  double outline_margin_m = 0.01;
 
   absl::Status Validate() const;
 };
@@ -28,6 +37,9 @@ struct FaceEvidence {
   int occluded = 0;     // ... measured in front of it (something on top)
   int see_through = 0;  // ... measured behind it (free space where the box would be)
   int missing = 0;      // ... no return
+  // Not in `expected`: pixels near the outline that are seen through or
+  // have no return (EvidenceOptions::outline_margin_m).
+  int border = 0;
   int visible() const { return expected - occluded; }
 };
 

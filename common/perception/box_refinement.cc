@@ -496,7 +496,12 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
   // as 8 x 4 cartons on their sides. Its continuing sides count as kTiled.
   const bool runs_on = std::any_of(result.sides.begin(), result.sides.end(),
                                    [](SideKind k) { return k == SideKind::kContinues; });
-  if (runs_on && options.max_tile_march_m > 0.0) {
+  // Only on a face that shows a seam (depth or colour) on another side: a
+  // plane known to be made of boxes. A flat plane with no seam anywhere (a
+  // laptop lid, a table top, a wall) is not tiled into boxes.
+  const bool seamed = std::any_of(result.sides.begin(), result.sides.end(),
+                                  [](SideKind k) { return k == SideKind::kSeam; });
+  if (runs_on && (seamed || options.tile_uncued_sides) && options.max_tile_march_m > 0.0) {
     const FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
     const Eigen::Vector3d axis_dir[2] = {f.a, f.b};
     const double size[2] = {2 * f.half_a, 2 * f.half_b};

@@ -44,6 +44,13 @@ struct RefinementOptions {
   double tile_gap_m = 0.002;
   double tile_tolerance_m = 0.01;
   double max_tile_march_m = 2.5;
+  // The layer rule above applies only to a face with a seam (in depth or
+  // colour) on at least one of its other sides: a flat plane of the right
+  // size with no seam anywhere (a laptop lid, a table top, a wall) tiles as
+  // well as a layer of touching boxes, and nothing in the frame tells them
+  // apart (precision first). True applies it to every face (a cell that
+  // sees only pallet layers of known boxes).
+  bool tile_uncued_sides = false;
   // With a registered colour image: a side where the face runs on is a seam
   // when a straight image line runs along all of it (seam_cues.h).
   SeamCueOptions colour_seams;

@@ -94,6 +94,9 @@ void DeriveGeometryParameters(double z, double focal_px, DetectorOptions* o) {
   const double smallest = std::min({o->box.l, o->box.b, o->box.h});
   double r = std::max(0.02, z > 0.0 && focal_px > 0.0 ? 6.0 * z / focal_px : 0.0);
   r = std::min(r, 0.35 * smallest);
+  // To half a millimetre: finer is below the depth noise, and a box whose
+  // rule lands within a hair of the default (a brick: 0.35 x 57 mm) keeps it.
+  r = std::round(r * 2000.0) / 2000.0;
   if (o->edge_points.radius_m == defaults.edge_points.radius_m) {
     o->edge_points.radius_m = r;
     if (o->segments.gap_m == defaults.segments.gap_m) o->segments.gap_m = r;
@@ -103,6 +106,9 @@ void DeriveGeometryParameters(double z, double focal_px, DetectorOptions* o) {
   }
   if (o->clubbing.meet_distance_m == defaults.clubbing.meet_distance_m) {
     o->clubbing.meet_distance_m = r / 2.0;
+  }
+  if (o->evidence.outline_margin_m == defaults.evidence.outline_margin_m) {
+    o->evidence.outline_margin_m = r / 2.0;
   }
 }
 

@@ -68,8 +68,9 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
       if (std::isnan(gc) || std::isnan(gl) || std::isnan(gr)) continue;
       // A change of shade between the two sides, or a line darker than both
       // (preferred where both show, so the offset is the line's middle).
+      const double valley = std::min(gl, gr) - gc;
       const double strength =
-          std::max<double>(0.75 * std::abs(gl - gr), std::min(gl, gr) - gc);
+          o.accept_steps ? std::max<double>(0.75 * std::abs(gl - gr), valley) : valley;
       if (strength > best) {
         best = strength;
         best_s = s;

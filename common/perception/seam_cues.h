@@ -17,6 +17,12 @@ struct SeamCueOptions {
   // Least brightness contrast (0-255 grey levels) across the line at a
   // sample: a step between the two sides or a valley darker than both.
   double min_contrast = 10.0;
+  // Whether a change of shade alone (a step) shows a seam. Off: touching
+  // boxes meet in a line darker than both (the gap's shadow); the edges of
+  // the tape strip along the middle of a carton's flaps are steps that run
+  // its whole length, exactly where a box shifted by half its width would
+  // have its side.
+  bool accept_steps = false;
   // Share of the samples along the side (its ends left out) that must show
   // the line at one offset. Unitless, (0, 1].
   double min_coverage = 0.75;

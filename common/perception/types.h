@@ -90,9 +90,11 @@ struct StageTimings {
   double edge_points_ms = 0.0;
   double edge_segments_ms = 0.0;
   double clubbing_ms = 0.0;
-  double faces_ms = 0.0;  // planar patches and their tilings
   double poses_ms = 0.0;
   double total_ms = 0.0;
+  // Planar patches and their tilings (last, so the fields above keep their
+  // order for aggregate initialisation).
+  double faces_ms = 0.0;
 };
 
 // How much work the pose stage did: hypotheses proposed (corners and

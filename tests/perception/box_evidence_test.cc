@@ -197,6 +197,46 @@ TEST(MeasureBoxTest, SampleCountIsBounded) {
   EXPECT_GT(ev.support(), 0.95);
 }
 
+// Stereo cameras lose or smear the pixels along a box's occluding outline
+// (edge fattening, flying pixels between the box and the floor behind it):
+// those are counted as border, not as seen through, while a box moved off
+// the real one is still contradicted.
+TEST(MeasureBoxTest, PixelsLostAlongTheOutlineAreBorderNotSeeThrough) {
+  const Rendered r = RenderScene(OneBoxScene(kCartonS, Yaw(20), 30.0, 40.0), NoNoise());
+  // Every pixel within 2 px of a jump to something 5 cm farther gets the
+  // depth of what lies behind (a ragged, fattened outline).
+  DepthImage smeared = r.depth;
+  const int w = r.depth.camera.width, h = r.depth.camera.height;
+  for (int v = 2; v < h - 2; ++v) {
+    for (int u = 2; u < w - 2; ++u) {
+      const float z = r.depth.at(u, v);
+      float farthest = z;
+      for (int dv = -2; dv <= 2; ++dv) {
+        for (int du = -2; du <= 2; ++du) farthest = std::max(farthest, r.depth.at(u + du, v + dv));
+      }
+      if (farthest > z + 0.05f) smeared.z[static_cast<size_t>(v) * w + u] = farthest;
+    }
+  }
+  const GroundTruthBox& gt = r.out.boxes[0];
+  EvidenceOptions none;
+  none.outline_margin_m = 0.0;
+  const BoxEvidence counted = MeasureBox(smeared, gt.camera_T_box, gt.dims, none);
+  const BoxEvidence discounted = MeasureBox(smeared, gt.camera_T_box, gt.dims, EvidenceOptions{});
+  Print("outline counted", counted);
+  Print("outline discounted", discounted);
+  EXPECT_EQ(counted.total.border, 0);
+  EXPECT_GT(counted.see_through_fraction(), 0.02);
+  EXPECT_GT(discounted.total.border, 0);
+  EXPECT_LT(discounted.see_through_fraction(), 0.005);
+  EXPECT_GT(discounted.support(), 0.95);
+  // 6 cm off along the floor: far more than the margin, still seen through.
+  const BoxEvidence moved = MeasureBox(
+      smeared, Shifted(r.scene, gt.camera_T_box, Eigen::Vector3d(0.06, 0.0, 0.0)), gt.dims,
+      EvidenceOptions{});
+  Print("moved 6 cm", moved);
+  EXPECT_GT(moved.see_through_fraction() + (1.0 - moved.support()), 0.1);
+}
+
 TEST(EvidenceOptionsTest, InvalidOptionsAreRefused) {
   EXPECT_TRUE(EvidenceOptions{}.Validate().ok());
   EvidenceOptions o;
@@ -205,6 +245,10 @@ TEST(EvidenceOptionsTest, InvalidOptionsAreRefused) {
   o = EvidenceOptions{};
   o.max_samples = 5;
   EXPECT_EQ(o.Validate().code(), absl::StatusCode::kInvalidArgument);
+  o = EvidenceOptions{};
+  o.outline_margin_m = -0.01;
+  EXPECT_EQ(o.Validate().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(o.Validate().message().find("outline_margin_m"), std::string::npos);
 }
 
 }  // namespace

@@ -216,6 +216,27 @@ TEST(ColourSeamTest, ARealSeamRunningTheWholeSideIsASeam) {
   EXPECT_NEAR(cue.offset_m, 0.0, 0.003);
 }
 
+// Packing tape along the middle of the flaps: a 5 cm strip whose edges are
+// steps of shade running the whole face. A step is not a seam (by default);
+// the dark line where two boxes meet is.
+TEST(ColourSeamTest, TheEdgeOfATapeStripIsNotASeam) {
+  LayerFrame f;
+  f.width = 0.6;
+  f.height = 0.2;
+  f.Render();
+  // A darker strip from a = 0 to a = 0.05 over the whole height: its edge
+  // lies on the line a = 0.
+  f.Paint({}, {}, {Eigen::Vector4d(0.0, -0.1, 0.05, 0.1)});
+  EXPECT_FALSE(CueAtMiddle(f).seam) << "coverage " << CueAtMiddle(f).coverage;
+  SeamCueOptions steps;
+  steps.accept_steps = true;
+  const SeamCue with_steps =
+      ColourSeamAlong(f.image, f.FromLayer(0.0, -f.height / 2, kTop),
+                      f.FromLayer(0.0, f.height / 2, kTop),
+                      f.FromLayer(1.0, 0.0, 0.0) - f.FromLayer(0.0, 0.0, 0.0), steps);
+  EXPECT_TRUE(with_steps.seam) << "coverage " << with_steps.coverage;
+}
+
 TEST(ColourSeamTest, ALabelAcrossTheLineDoesNotMakeASeam) {
   LayerFrame f;
   f.width = 0.6;

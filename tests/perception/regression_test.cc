@@ -109,7 +109,7 @@ TEST(RegressionTest, NoWrongBoxOnIsolatedAndHeapScenes) {
     DetectorOptions options;
     options.box = c.dims;
     const absl::StatusOr<Detection> det = DetectBoxes(out.cloud, options);
-    ASSERT_TRUE(det.ok());
+    ASSERT_TRUE(det.ok()) << det.status();
     for (const DetectedBox& box : det->boxes) {
       double nearest_m = 1e9, nearest_deg = 1e9;
       for (const GroundTruthBox& gt : out.boxes) {
@@ -121,8 +121,24 @@ TEST(RegressionTest, NoWrongBoxOnIsolatedAndHeapScenes) {
       }
       EXPECT_LT(nearest_m, 0.02) << (c.heap ? "heap" : "isolated") << " l=" << c.dims.l << " seed "
                                  << c.seed << ": box off by " << nearest_deg << " deg, score "
-                                 << box.score;
+                                 << box.score << (box.from_face ? " (face proposal)" : " (corner)");
     }
+  }
+}
+
+// Was: a flat plane twice a box's face in each direction (a laptop lid, a
+// table top, a block of the box's height) tiled into 2 x 2 boxes by the
+// layer rule, with no seam anywhere. A side with no cue in depth or colour
+// on a face with no seam is declined.
+TEST(RegressionTest, AnUnbrokenFlatPlaneIsNotTiledIntoBoxes) {
+  const BoxDims block{0.60, 0.40, 0.15};  // 2 x 2 carton_s tops, no seams
+  for (uint32_t seed : {1u, 2u, 3u}) {
+    const RenderedScene out = Render(MakeIsolatedScene(block, 1, seed), NoiseOptions{});
+    DetectorOptions options;
+    options.box = kCartonS;
+    const absl::StatusOr<Detection> det = DetectBoxes(out.cloud, options);
+    ASSERT_TRUE(det.ok()) << det.status();
+    EXPECT_TRUE(det->boxes.empty()) << "seed " << seed << ": " << det->boxes.size() << " boxes";
   }
 }
 
