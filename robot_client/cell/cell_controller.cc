@@ -44,7 +44,7 @@ CellController::CellController(RobotClientOptions options, CellControllerOptions
       callbacks_(std::move(callbacks)),
       link_(options_.robot),
       reachable_(MakeIkReachability(options_.robot.arm_model, options_.gripper.flange_T_tcp)),
-      not_before_(absl::Now()) {
+      floor_(perception_->FloorAfterNow()) {
   status_.num_slots = SlotCount(options_.place_pattern);
   status_.dry_run = options_.dry_run;
   bring_up_allowed_ = options_.robot.bring_up_at_start;
@@ -290,8 +290,7 @@ bool CellController::Step() {
 }
 
 std::optional<FrameDetection> CellController::AwaitFreshFrame() {
-  std::optional<FrameDetection> frame =
-      perception_->WaitForFrameAfter(not_before_, controller_.frame_wait);
+  std::optional<FrameDetection> frame = perception_->WaitForFrame(floor_, controller_.frame_wait);
   if (!frame) {
     if (!perception_->connected()) {
       const std::string error = perception_->last_error();
@@ -305,7 +304,7 @@ std::optional<FrameDetection> CellController::AwaitFreshFrame() {
   }
   SetState(CellState::kIdle);
   // Judge each frame once.
-  not_before_ = std::max(not_before_, frame->capture_time);
+  floor_.not_before = std::max(floor_.not_before, frame->capture_time);
   return frame;
 }
 
@@ -379,7 +378,7 @@ void CellController::RunPick(PreparedPick pick) {
   record.start_time = absl::Now();
   if (options_.dry_run) {
     record.outcome = PickOutcome::kDryRun;
-    not_before_ = absl::Now();
+    floor_ = perception_->FloorAfterNow();
     Record(std::move(record));
     return;
   }
@@ -429,8 +428,8 @@ void CellController::RunPick(PreparedPick pick) {
       break;
   }
   // Every frame captured until now may show the arm or the old scene.
-  not_before_ = absl::Now();
-  record.program_s = absl::ToDoubleSeconds(not_before_ - record.start_time);
+  floor_ = perception_->FloorAfterNow();
+  record.program_s = absl::ToDoubleSeconds(floor_.not_before - record.start_time);
   // The primary interface reported the stop; let RTDE catch up so the next
   // step sees it and waits for it to clear instead of sending a program.
   if (outcome.kind == ur::ProgramOutcome::kProtectiveStop) {

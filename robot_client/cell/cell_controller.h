@@ -139,10 +139,10 @@ class CellController {
   std::deque<PickRecord> records_;  // guarded by mutex_
 
   // Loop state (controller thread only).
-  // Frames captured at or before this are not used: the end of the last
-  // move (the arm may have been in view, the scene has changed), or a frame
-  // already judged.
-  absl::Time not_before_;
+  // Frames before this are not used: captured before the end of the last
+  // move (the arm may have been in view, the scene has changed) by the
+  // server's stamp and by the source's frame order, or already judged.
+  FrameFloor floor_;
   uint64_t next_pick_id_ = 1;
   // A program may still run (start, a reconnect, a timeout, a lost link):
   // stop and confirm before planning.

@@ -186,6 +186,9 @@ TEST_F(CellTest, PicksRealBoxesAndPlacesThemSlotBySlot) {
       const double previous_end_ns =
           static_cast<double>(previous.start_time_unix_nanos()) + previous.program_s() * 1e9;
       EXPECT_GT(static_cast<double>(pick.capture_time_unix_nanos()), previous_end_ns);
+      // And by the source's own frame order: past the frame in flight when
+      // the previous move ended.
+      EXPECT_GE(pick.frame_id(), previous.frame_id() + 2);
     }
   }
 
