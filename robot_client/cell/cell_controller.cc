@@ -27,8 +27,11 @@ PickOutcome OutcomeOf(ur::ProgramOutcome::Kind kind) {
       return PickOutcome::kConnectionLost;
     case ur::ProgramOutcome::kTimeout:
       return PickOutcome::kTimeout;
+    case ur::ProgramOutcome::kUnfinished:
+    case ur::ProgramOutcome::kCancelled:
+      return PickOutcome::kUnknown;
   }
-  return PickOutcome::kTimeout;
+  return PickOutcome::kUnknown;
 }
 
 }  // namespace
@@ -41,9 +44,10 @@ CellController::CellController(RobotClientOptions options, CellControllerOptions
       callbacks_(std::move(callbacks)),
       link_(options_.robot),
       reachable_(MakeIkReachability(options_.robot.arm_model, options_.gripper.flange_T_tcp)),
-      not_before_(absl::Now()) {
+      floor_(perception_->FloorAfterNow()) {
   status_.num_slots = SlotCount(options_.place_pattern);
   status_.dry_run = options_.dry_run;
+  bring_up_allowed_ = options_.robot.bring_up_at_start;
 }
 
 void CellController::Run() {
@@ -102,6 +106,10 @@ void CellController::Record(PickRecord record) {
     } else {
       ++status_.picks_failed;
     }
+    if (record.outcome == PickOutcome::kUnknown) {
+      status_.unknown_pick_id = record.pick_id;
+      unknown_pick_slot_ = record.plan.slot;
+    }
     records_.push_back(record);
     while (records_.size() > controller_.max_records) records_.pop_front();
   }
@@ -116,44 +124,150 @@ bool CellController::SuctionOn(const ur::RtdeState& state) const {
   return (state.digital_outputs >> bit) & 1u;
 }
 
+bool CellController::Halt(const std::string& reason) {
+  SetState(CellState::kStopped, reason);
+  Pause(controller_.retry_interval);
+  return false;
+}
+
+bool CellController::StopProgramNow() {
+  if (absl::Status s = link_.StopProgramAndConfirm(); !s.ok()) {
+    Note(absl::StrCat("cannot stop the program: ", s.message(), "; reconnecting"));
+    link_.Close();
+    program_check_pending_ = true;
+    return false;
+  }
+  program_check_pending_ = false;
+  return true;
+}
+
+absl::StatusOr<std::string> CellController::AcknowledgeFault(const std::string& operator_name,
+                                                             const std::string& note,
+                                                             bool unknown_pick_placed) {
+  if (operator_name.empty()) {
+    return absl::InvalidArgumentError("AcknowledgeFault: operator is required");
+  }
+  std::string cleared;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!status_.awaiting_acknowledgement && status_.unknown_pick_id == 0 &&
+        latched_fault_.empty()) {
+      return absl::FailedPreconditionError("nothing waits for an acknowledgement");
+    }
+    bring_up_allowed_ = true;
+    if (!latched_fault_.empty()) cleared = latched_fault_;
+    latched_fault_.clear();
+    if (status_.unknown_pick_id != 0) {
+      absl::StrAppend(&cleared, cleared.empty() ? "" : "; ", "pick ", status_.unknown_pick_id,
+                      unknown_pick_placed ? " placed: slot " : " not placed: slot ",
+                      unknown_pick_slot_, unknown_pick_placed ? " taken" : " used again");
+      if (unknown_pick_placed) {
+        ++status_.next_slot;
+        ++status_.picks_done;
+        --status_.picks_failed;
+      }
+      status_.unknown_pick_id = 0;
+      unknown_pick_slot_ = -1;
+    }
+    if (cleared.empty()) cleared = "power-on and brake release allowed";
+    status_.last_acknowledgement =
+        absl::StrCat(operator_name, " at ", absl::FormatTime(absl::Now()), ": ", note);
+    status_.awaiting_acknowledgement = false;
+  }
+  Note(absl::StrCat("acknowledged by ", operator_name, " (", note, "): ", cleared));
+  stop_cv_.notify_all();
+  return cleared;
+}
+
 bool CellController::RobotReady() {
   if (options_.dry_run) return true;
   if (!link_.connected()) {
     link_.Close();
+    // Whatever ran before the link went is stopped before anything new.
+    program_check_pending_ = true;
     if (absl::Status s = link_.Connect(); !s.ok()) {
-      SetState(CellState::kStopped, absl::StrCat("controller not reachable: ", s.message()));
-      Pause(controller_.retry_interval);
-      return false;
+      return Halt(absl::StrCat("controller not reachable: ", s.message()));
     }
   }
-  if (std::optional<std::string> stop = link_.SafetyStop()) {
-    SetState(CellState::kStopped, absl::StrCat(*stop, "; waiting for it to be cleared"));
-    Pause(controller_.retry_interval);
-    return false;
+  if (std::optional<std::string> bad = link_.Unhealthy()) {
+    // Silent or stale: reconnect (the stale state is never planned from).
+    link_.Close();
+    program_check_pending_ = true;
+    return Halt(absl::StrCat("controller link not trusted: ", *bad));
+  }
+  if (program_check_pending_ && !StopProgramNow()) {
+    return Halt("cannot confirm that no program runs on the controller");
+  }
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (status_.unknown_pick_id != 0) {
+      status_.awaiting_acknowledgement = true;
+      const std::string reason = absl::StrCat(
+          "pick ", status_.unknown_pick_id, " ended unknown; slot ", unknown_pick_slot_,
+          " is not reused until an operator says whether its box is there (AcknowledgeFault)");
+      lock.unlock();
+      return Halt(reason);
+    }
   }
   absl::StatusOr<ur::RtdeState> state = link_.State();
   if (!state.ok()) {
-    SetState(CellState::kStopped, absl::StrCat("no robot state: ", state.status().message()));
-    Pause(controller_.retry_interval);
-    return false;
+    return Halt(absl::StrCat("no robot state: ", state.status().message()));
+  }
+  const auto safety = static_cast<ur::SafetyMode>(state->safety_mode);
+  const bool latching = safety == ur::SafetyMode::kSystemEmergencyStop ||
+                        safety == ur::SafetyMode::kRobotEmergencyStop ||
+                        safety == ur::SafetyMode::kViolation || safety == ur::SafetyMode::kFault;
+  if (latching) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    latched_fault_ = absl::StrCat("safety mode ", ur::SafetyModeName(safety));
+    bring_up_allowed_ = false;
+  }
+  if (std::optional<std::string> stop = link_.SafetyStop()) {
+    return Halt(absl::StrCat(*stop, "; waiting for it to be cleared"));
+  }
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (!latched_fault_.empty()) {
+      status_.awaiting_acknowledgement = true;
+      const std::string reason = absl::StrCat(
+          latched_fault_, " was reset; waiting for an operator's AcknowledgeFault before "
+                          "power-on and brake release");
+      lock.unlock();
+      return Halt(reason);
+    }
   }
   // A pick cut short (a protective stop, say) can leave the vacuum on and a
   // box on the cup; the next program would carry it into the pile. That is
   // for an operator to clear: wait until the output is off.
   if (SuctionOn(*state)) {
-    SetState(CellState::kStopped,
-             "the suction output is on with no pick running (a box may still be on the "
-             "gripper): clear it and switch the output off");
-    Pause(controller_.retry_interval);
-    return false;
+    return Halt(
+        "the suction output is on with no pick running (a box may still be on the "
+        "gripper): clear it and switch the output off");
   }
-  if (static_cast<ur::RobotMode>(state->robot_mode) != ur::RobotMode::kRunning) {
+  const auto mode = static_cast<ur::RobotMode>(state->robot_mode);
+  if (mode != ur::RobotMode::kRunning) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (!bring_up_allowed_) {
+        status_.awaiting_acknowledgement = true;
+        const std::string reason = absl::StrCat(
+            "robot mode ", ur::RobotModeName(mode),
+            ": waiting for an operator's AcknowledgeFault before power-on and brake release");
+        lock.unlock();
+        return Halt(reason);
+      }
+    }
     SetState(CellState::kStarting, "bringing the arm up (power on, brake release)");
     if (absl::Status s = link_.BringUp(controller_.bring_up_timeout); !s.ok()) {
-      SetState(CellState::kStopped, absl::StrCat("bring-up failed: ", s.message()));
-      Pause(controller_.retry_interval);
-      return false;
+      return Halt(absl::StrCat("bring-up failed: ", s.message()));
     }
+    std::lock_guard<std::mutex> lock(mutex_);
+    // One acknowledgement, one bring-up.
+    bring_up_allowed_ = false;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    status_.awaiting_acknowledgement = false;
   }
   return true;
 }
@@ -176,8 +290,7 @@ bool CellController::Step() {
 }
 
 std::optional<FrameDetection> CellController::AwaitFreshFrame() {
-  std::optional<FrameDetection> frame =
-      perception_->WaitForFrameAfter(not_before_, controller_.frame_wait);
+  std::optional<FrameDetection> frame = perception_->WaitForFrame(floor_, controller_.frame_wait);
   if (!frame) {
     if (!perception_->connected()) {
       const std::string error = perception_->last_error();
@@ -191,7 +304,7 @@ std::optional<FrameDetection> CellController::AwaitFreshFrame() {
   }
   SetState(CellState::kIdle);
   // Judge each frame once.
-  not_before_ = std::max(not_before_, frame->capture_time);
+  floor_.not_before = std::max(floor_.not_before, frame->capture_time);
   return frame;
 }
 
@@ -207,12 +320,24 @@ std::optional<CellController::PreparedPick> CellController::PreparePick(const Fr
                                                                         const ur::Joints& joints,
                                                                         int slot) {
   const absl::Time plan_start = absl::Now();
-  // The size the server detected with: it alone resolves model names.
-  const BoxDims dims = frame.box_dims.value_or(options_.perception.box);
+  // The daemon asks for explicit dimensions; grasp depth and layer heights
+  // are planned for them, so a response detected with other ones (or not
+  // saying which) is refused.
+  const BoxDims dims = options_.perception.box;
+  const std::string frame_name = absl::StrCat(frame.source, "#", frame.frame_id);
+  if (!frame.box_dims || ((frame.box_dims->vec() - dims.vec()).cwiseAbs().maxCoeff() > 5e-4)) {
+    const std::string used =
+        frame.box_dims ? absl::StrCat(frame.box_dims->l, " x ", frame.box_dims->b, " x ",
+                                      frame.box_dims->h, " m")
+                       : std::string("unknown dimensions");
+    SetState(CellState::kStopped,
+             absl::StrCat(frame_name, ": refused: detected with ", used, ", not the configured ",
+                          dims.l, " x ", dims.b, " x ", dims.h, " m"));
+    return std::nullopt;
+  }
   const PickSelection selection =
       SelectPick(frame.boxes, options_.base_T_camera, dims, options_.selection, options_.workspace,
                  options_.waypoints, reachable_);
-  const std::string frame_name = absl::StrCat(frame.source, "#", frame.frame_id);
   if (!selection.chosen) {
     Note(absl::StrCat(frame_name, ": ", DescribeRejections(selection)));
     return std::nullopt;
@@ -253,26 +378,72 @@ void CellController::RunPick(PreparedPick pick) {
   record.start_time = absl::Now();
   if (options_.dry_run) {
     record.outcome = PickOutcome::kDryRun;
-    not_before_ = absl::Now();
+    floor_ = perception_->FloorAfterNow();
     Record(std::move(record));
     return;
   }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (stopping_) return;  // not planned to run: no record
+  }
   SetState(CellState::kPicking);
+  // Polled while the program runs: a stop request or a link that went
+  // silent or stale ends the wait at once (the program is then stopped).
+  auto cancel = [this]() -> std::optional<std::string> {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (stopping_) return "the daemon is stopping";
+    }
+    if (std::optional<std::string> bad = link_.Unhealthy()) {
+      return absl::StrCat("controller link not trusted: ", *bad);
+    }
+    return std::nullopt;
+  };
   const ur::ProgramOutcome outcome =
-      link_.RunProgram(record.program_name, pick.program, controller_.program_timeout);
-  // Every frame captured until now may show the arm or the old scene.
-  not_before_ = absl::Now();
-  record.program_s = absl::ToDoubleSeconds(not_before_ - record.start_time);
+      link_.RunProgram(record.program_name, pick.program, controller_.program_timeout, cancel);
   record.outcome = OutcomeOf(outcome.kind);
   record.detail = outcome.detail;
-  if (outcome.kind == ur::ProgramOutcome::kConnectionLost) link_.Close();
+  switch (outcome.kind) {
+    case ur::ProgramOutcome::kCompleted:
+    case ur::ProgramOutcome::kRuntimeException:
+    case ur::ProgramOutcome::kProtectiveStop:
+      // The controller said how the program ended; still confirm nothing
+      // runs before the next one.
+      program_check_pending_ = true;
+      break;
+    case ur::ProgramOutcome::kConnectionLost:
+    case ur::ProgramOutcome::kTimeout:
+    case ur::ProgramOutcome::kUnfinished:
+    case ur::ProgramOutcome::kCancelled:
+      // Where the arm and the box are is unknown: stop the program now
+      // (or on reconnect) and wait for an operator.
+      record.outcome = PickOutcome::kUnknown;
+      record.detail = absl::StrCat(ur::ProgramOutcomeName(outcome.kind), ": ", outcome.detail);
+      program_check_pending_ = true;
+      if (outcome.kind == ur::ProgramOutcome::kConnectionLost) {
+        link_.Close();
+      } else {
+        StopProgramNow();
+      }
+      break;
+  }
+  // Every frame captured until now may show the arm or the old scene.
+  floor_ = perception_->FloorAfterNow();
+  record.program_s = absl::ToDoubleSeconds(floor_.not_before - record.start_time);
   // The primary interface reported the stop; let RTDE catch up so the next
   // step sees it and waits for it to clear instead of sending a program.
   if (outcome.kind == ur::ProgramOutcome::kProtectiveStop) {
     link_.WaitForSafetyStop(absl::Seconds(2));
   }
+  const bool unknown = record.outcome == PickOutcome::kUnknown;
+  const std::string why = absl::StrCat("pick ", record.pick_id, " ended unknown (", record.detail,
+                                       "); waiting for an operator's AcknowledgeFault");
   Record(std::move(record));
-  SetState(CellState::kIdle);
+  if (unknown) {
+    SetState(CellState::kStopped, why);
+  } else {
+    SetState(CellState::kIdle);
+  }
 }
 
 void CellController::Note(const std::string& message) {

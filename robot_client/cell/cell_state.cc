@@ -35,6 +35,8 @@ const char* PickOutcomeName(PickOutcome outcome) {
       return "DRY_RUN";
     case PickOutcome::kTimeout:
       return "TIMEOUT";
+    case PickOutcome::kUnknown:
+      return "UNKNOWN";
   }
   return "UNKNOWN";
 }

@@ -25,6 +25,12 @@ struct CellStatusSnapshot {
   bool perception_connected = false;
   bool robot_connected = false;
   bool dry_run = false;
+  // Waiting for an operator's AcknowledgeFault.
+  bool awaiting_acknowledgement = false;
+  // The pick whose end is unknown; 0: none.
+  uint64_t unknown_pick_id = 0;
+  // "operator at time: note" of the last acknowledgement.
+  std::string last_acknowledgement;
 };
 
 enum class PickOutcome {
@@ -34,6 +40,9 @@ enum class PickOutcome {
   kConnectionLost,
   kDryRun,
   kTimeout,
+  // The program's end is unknown (timeout, lost / stale link, stopped
+  // before its done message): needs an operator's acknowledgement.
+  kUnknown,
 };
 // "COMPLETED", "PROTECTIVE_STOP", ...
 const char* PickOutcomeName(PickOutcome outcome);

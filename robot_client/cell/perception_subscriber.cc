@@ -57,6 +57,28 @@ std::optional<FrameDetection> PerceptionSubscriber::WaitForFrameAfter(absl::Time
   return latest_;
 }
 
+std::optional<FrameDetection> PerceptionSubscriber::WaitForFrame(const FrameFloor& floor,
+                                                                 absl::Duration timeout) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const auto fresh = [&] {
+    return latest_ && latest_->capture_time > floor.not_before &&
+           (latest_->stream != floor.stream || latest_->frame_id >= floor.min_frame_id) &&
+           absl::Now() - latest_->received <= options_.max_frame_age;
+  };
+  changed_.wait_for(lock, absl::ToChronoNanoseconds(timeout), [&] { return stopping_ || fresh(); });
+  if (stopping_ || !fresh()) return std::nullopt;
+  return latest_;
+}
+
+FrameFloor PerceptionSubscriber::FloorAfterNow() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  FrameFloor floor;
+  floor.not_before = absl::Now();
+  floor.stream = stream_;
+  floor.min_frame_id = latest_ && latest_->stream == stream_ ? latest_->frame_id + 2 : 0;
+  return floor;
+}
+
 bool PerceptionSubscriber::SleepUnlessStopped(absl::Duration d) {
   std::unique_lock<std::mutex> lock(mutex_);
   changed_.wait_for(lock, absl::ToChronoNanoseconds(d), [&] { return stopping_; });
@@ -96,6 +118,11 @@ void PerceptionSubscriber::Run() {
     }
     std::unique_ptr<grpc::ClientReader<v1::DetectResponse>> reader =
         stub->StreamDetections(&context, request);
+    uint64_t stream = 0;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stream = ++stream_;
+    }
     v1::DetectResponse response;
     while (reader->Read(&response)) {
       absl::StatusOr<std::vector<DetectedBox>> boxes = wire::BoxesFromProto(response);
@@ -112,7 +139,9 @@ void PerceptionSubscriber::Run() {
                           : std::nullopt,
           .source = response.source(),
           .frame_id = response.frame_id(),
-          .capture_time = absl::FromUnixNanos(response.capture_time_unix_nanos())};
+          .capture_time = absl::FromUnixNanos(response.capture_time_unix_nanos()),
+          .stream = stream,
+          .received = absl::Now()};
       connected_ = true;
       ++frames_received_;
       backoff = options_.initial_backoff;
@@ -123,6 +152,8 @@ void PerceptionSubscriber::Run() {
       std::lock_guard<std::mutex> lock(mutex_);
       context_ = nullptr;
       connected_ = false;
+      // A detection from a dropped stream is not picked from later.
+      latest_.reset();
       if (stopping_) return;
       last_error_ = end.ok() ? absl::StrCat("source '", options_.source, "' ended")
                              : absl::StrCat("perception stream from ", options_.server,

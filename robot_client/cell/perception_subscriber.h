@@ -37,6 +37,9 @@ struct PerceptionSubscriberOptions {
   // doubles per failed attempt up to `max`, resets once a frame arrives.
   absl::Duration initial_backoff = absl::Milliseconds(200);
   absl::Duration max_backoff = absl::Seconds(5);
+  // A detection received longer ago than this (this machine's clock) is
+  // not used: the stream has stalled.
+  absl::Duration max_frame_age = absl::Seconds(2);
 };
 
 // One frame's detected boxes and where they came from.
@@ -49,6 +52,20 @@ struct FrameDetection {
   std::string source;
   uint64_t frame_id = 0;
   absl::Time capture_time;
+  // Which stream delivered it (one per (re)opened subscription; frame ids
+  // are ordered within one) and when it arrived here.
+  uint64_t stream = 0;
+  absl::Time received;
+};
+
+// Which frames are fresh: stamped after `not_before` by the server and, in
+// the same stream, with a frame id of at least `min_frame_id` (the source's
+// own frame order: the frame in flight when a motion ended may have been
+// exposed during it, so it is skipped too).
+struct FrameFloor {
+  absl::Time not_before = absl::InfinitePast();
+  uint64_t stream = 0;
+  uint64_t min_frame_id = 0;
 };
 
 class PerceptionSubscriber {
@@ -67,6 +84,12 @@ class PerceptionSubscriber {
   // The newest detection of a frame captured strictly after `not_before`,
   // waiting up to `timeout` for one; nullopt when none came.
   std::optional<FrameDetection> WaitForFrameAfter(absl::Time not_before, absl::Duration timeout);
+  // The newest detection fresh by `floor` and received within
+  // max_frame_age; nullopt when none came within `timeout`.
+  std::optional<FrameDetection> WaitForFrame(const FrameFloor& floor, absl::Duration timeout);
+  // The floor for "after now": the server's frames stamped after now and,
+  // in the current stream, ids past the newest received + 1.
+  FrameFloor FloorAfterNow() const;
 
   // True while the stream is open and has delivered a frame.
   bool connected() const;
@@ -88,7 +111,8 @@ class PerceptionSubscriber {
   bool connected_ = false;                  // guarded by mutex_
   std::string last_error_;                  // guarded by mutex_
   uint64_t frames_received_ = 0;            // guarded by mutex_
-  std::optional<FrameDetection> latest_;    // guarded by mutex_
+  std::optional<FrameDetection> latest_;    // guarded by mutex_; reset when the stream drops
+  uint64_t stream_ = 0;                     // guarded by mutex_
   grpc::ClientContext* context_ = nullptr;  // guarded by mutex_; the open call
   std::thread thread_;
 };

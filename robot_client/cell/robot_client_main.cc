@@ -8,7 +8,10 @@
 //
 // Flags given override the file. Prints one line per pick and per state
 // change; runs until the place pattern is full, max_picks are made, or
-// SIGINT / SIGTERM (a running program is followed to its end first).
+// SIGINT / SIGTERM: a running program is then stopped through the
+// dashboard and confirmed stopped (robot.stop_confirm_timeout_s, 3 s by
+// default), its pick logged UNKNOWN, and the daemon exits 0, well inside the
+// systemd unit's TimeoutStopSec (20 s).
 #include <semaphore.h>
 
 #include <csignal>
@@ -128,8 +131,10 @@ int main(int argc, char** argv) {
   PerceptionSubscriberOptions perception;
   perception.server = options.perception.server_address;
   perception.source = options.perception.source;
+  // Explicit dimensions (the config resolved box_model): the server detects
+  // with exactly the size the daemon plans for, and echoes it.
   perception.box_model = options.perception.box_model;
-  if (options.perception.box_model.empty()) perception.box = options.perception.box;
+  perception.box = options.perception.box;
   perception.initial_backoff = absl::Seconds(options.perception.reconnect_initial_s);
   perception.max_backoff = absl::Seconds(options.perception.reconnect_max_s);
   PerceptionSubscriber subscriber(perception);

@@ -11,9 +11,12 @@ namespace cornerpose::robot_client {
 RobotLink::RobotLink(RobotConnectionOptions options)
     : options_(std::move(options)),
       dashboard_(std::make_unique<ur::DashboardClient>()),
-      primary_(std::make_unique<ur::PrimaryClient>()),
+      primary_(std::make_unique<ur::PrimaryClient>(
+          ur::PrimaryClientOptions{.read_timeout = absl::Seconds(options_.read_timeout_s)})),
       rtde_(std::make_unique<ur::RtdeClient>(
-          ur::RtdeClientOptions{.frequency = options_.rtde_frequency_hz})) {}
+          ur::RtdeClientOptions{.frequency = options_.rtde_frequency_hz,
+                                .read_timeout = absl::Seconds(options_.read_timeout_s),
+                                .max_age = absl::Seconds(options_.rtde_max_age_s)})) {}
 
 absl::Status RobotLink::Connect() {
   const absl::Duration timeout = absl::Seconds(options_.connect_timeout_s);
@@ -45,6 +48,50 @@ void RobotLink::Close() {
 
 absl::StatusOr<ur::RtdeState> RobotLink::State() const { return rtde_->Latest(); }
 
+std::optional<std::string> RobotLink::Unhealthy() const {
+  if (!dashboard_->connected()) return "dashboard server connection lost";
+  if (!primary_->connected()) {
+    return absl::StrCat("primary interface lost: ", primary_->connection_status().message());
+  }
+  absl::StatusOr<ur::RtdeState> state = rtde_->Latest();
+  if (!state.ok()) return std::string(state.status().message());
+  return std::nullopt;
+}
+
+absl::Status RobotLink::StopProgramAndConfirm() {
+  const absl::Time deadline = absl::Now() + absl::Seconds(options_.stop_confirm_timeout_s);
+  const absl::Time stop_sent = absl::Now();
+  // "Failed to execute: stop" means no program was running: fine, the
+  // RTDE check below is what counts.
+  absl::Status stop = dashboard_->Stop(absl::Seconds(options_.stop_confirm_timeout_s));
+  if (!stop.ok() && !absl::IsFailedPrecondition(stop)) {
+    return absl::Status(stop.code(),
+                        absl::StrCat("dashboard stop failed: ", stop.message()));
+  }
+  // Bit 1 of robot_status_bits: a program runs; runtime_state 1: stopped.
+  constexpr uint32_t kProgramRunningBit = 1u << 1;
+  constexpr uint32_t kRuntimeStopped = 1;
+  absl::StatusOr<ur::RtdeState> state = rtde_->Latest();
+  uint64_t sequence = state.ok() ? state->sequence : 0;
+  std::string last = state.ok() ? "no state after the stop" : std::string(state.status().message());
+  while (absl::Now() < deadline) {
+    state = rtde_->WaitForNewer(sequence, deadline - absl::Now());
+    if (!state.ok()) {
+      last = std::string(state.status().message());
+      if (!absl::IsDeadlineExceeded(state.status())) break;
+      continue;
+    }
+    sequence = state->sequence;
+    if (state->received < stop_sent) continue;
+    if (state->runtime_state == kRuntimeStopped && (state->robot_status_bits & kProgramRunningBit) == 0) {
+      return absl::OkStatus();
+    }
+    last = absl::StrCat("runtime state ", state->runtime_state, ", program still running");
+  }
+  return absl::DeadlineExceededError(
+      absl::StrCat("cannot confirm the program stopped: ", last));
+}
+
 std::optional<std::string> RobotLink::SafetyStop() const {
   absl::StatusOr<ur::RtdeState> state = rtde_->Latest();
   if (!state.ok()) return std::nullopt;
@@ -74,12 +121,19 @@ absl::Status RobotLink::BringUp(absl::Duration timeout) {
 }
 
 ur::ProgramOutcome RobotLink::RunProgram(absl::string_view name, absl::string_view text,
-                                         absl::Duration timeout) {
+                                         absl::Duration timeout,
+                                         std::function<std::optional<std::string>()> cancel) {
   if (absl::Status s = primary_->SendScript(text); !s.ok()) {
-    return ur::ProgramOutcome{.kind = ur::ProgramOutcome::kConnectionLost,
-                              .detail = std::string(s.message())};
+    ur::ProgramOutcome lost;
+    lost.kind = ur::ProgramOutcome::kConnectionLost;
+    lost.detail = std::string(s.message());
+    return lost;
   }
-  return primary_->WaitForProgram(name, timeout);
+  ur::ProgramWait wait;
+  wait.timeout = timeout;
+  wait.done_text = absl::StrCat(name, ": done");
+  wait.cancel = std::move(cancel);
+  return primary_->WaitForProgram(name, wait);
 }
 
 }  // namespace cornerpose::robot_client

@@ -4,6 +4,7 @@
 // safety and robot mode at the configured rate). See ur-interface.md.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -30,8 +31,13 @@ class RobotLink {
   bool connected() const;
   void Close();
 
-  // The newest RTDE state; UNAVAILABLE when not connected.
+  // The newest RTDE state; UNAVAILABLE when not connected,
+  // DEADLINE_EXCEEDED when older than rtde_max_age_s (a stalled stream).
   absl::StatusOr<ur::RtdeState> State() const;
+
+  // Why the link cannot be trusted now (a connection down, RTDE stale);
+  // nullopt when it can.
+  std::optional<std::string> Unhealthy() const;
 
   // Why the arm cannot move now: a protective, safeguard or emergency stop,
   // or a safety fault (from the RTDE safety mode); nullopt when the safety
@@ -47,8 +53,17 @@ class RobotLink {
   absl::Status BringUp(absl::Duration timeout);
 
   // Sends the program and follows it to its end on the primary interface.
+  // Completed only on the program's own done message (`<name>: done`);
+  // `cancel` is polled while it runs (see ur::ProgramWait).
   ur::ProgramOutcome RunProgram(absl::string_view name, absl::string_view text,
-                                absl::Duration timeout);
+                                absl::Duration timeout,
+                                std::function<std::optional<std::string>()> cancel = {});
+
+  // Stops whatever program runs (dashboard `stop`) and waits, within
+  // stop_confirm_timeout_s, for a fresh RTDE state received after the stop
+  // that says no program runs (runtime state STOPPED, program-running bit
+  // clear). OK only then; the reason otherwise.
+  absl::Status StopProgramAndConfirm();
 
  private:
   const RobotConnectionOptions options_;

@@ -55,6 +55,8 @@ v1::PickOutcome OutcomeToProto(PickOutcome outcome) {
       return v1::PICK_OUTCOME_DRY_RUN;
     case PickOutcome::kTimeout:
       return v1::PICK_OUTCOME_TIMEOUT;
+    case PickOutcome::kUnknown:
+      return v1::PICK_OUTCOME_UNKNOWN;
   }
   return v1::PICK_OUTCOME_UNSPECIFIED;
 }
@@ -72,6 +74,9 @@ v1::CellStatus ToProto(const CellStatusSnapshot& status) {
   out.set_perception_connected(status.perception_connected);
   out.set_robot_connected(status.robot_connected);
   out.set_dry_run(status.dry_run);
+  out.set_awaiting_acknowledgement(status.awaiting_acknowledgement);
+  out.set_unknown_pick_id(status.unknown_pick_id);
+  out.set_last_acknowledgement(status.last_acknowledgement);
   return out;
 }
 
@@ -118,6 +123,22 @@ grpc::ServerUnaryReactor* StatusServiceImpl::ListPicks(grpc::CallbackServerConte
   return reactor;
 }
 
+grpc::ServerUnaryReactor* StatusServiceImpl::AcknowledgeFault(
+    grpc::CallbackServerContext* context, const v1::AcknowledgeFaultRequest* request,
+    v1::AcknowledgeFaultResponse* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  absl::StatusOr<std::string> cleared =
+      cell_->AcknowledgeFault(request->operator_(), request->note(), request->unknown_pick_placed());
+  if (!cleared.ok()) {
+    reactor->Finish(grpc::Status(static_cast<grpc::StatusCode>(cleared.status().code()),
+                                 std::string(cleared.status().message())));
+    return reactor;
+  }
+  response->set_cleared(*cleared);
+  reactor->Finish(grpc::Status::OK);
+  return reactor;
+}
+
 StatusServer::~StatusServer() { Shutdown(); }
 
 void StatusServer::Shutdown() {
@@ -130,7 +151,7 @@ void StatusServer::Shutdown() {
 }
 
 absl::StatusOr<std::unique_ptr<StatusServer>> StartStatusServer(const std::string& listen_address,
-                                                                const CellController* cell) {
+                                                                CellController* cell) {
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   auto out = std::unique_ptr<StatusServer>(new StatusServer());

@@ -16,7 +16,7 @@ namespace cornerpose::robot_client {
 
 class StatusServiceImpl final : public v1::RobotClientService::CallbackService {
  public:
-  explicit StatusServiceImpl(const CellController* cell) : cell_(cell) {}
+  explicit StatusServiceImpl(CellController* cell) : cell_(cell) {}
 
   grpc::ServerUnaryReactor* GetCellStatus(grpc::CallbackServerContext* context,
                                           const v1::GetCellStatusRequest* request,
@@ -24,9 +24,12 @@ class StatusServiceImpl final : public v1::RobotClientService::CallbackService {
   grpc::ServerUnaryReactor* ListPicks(grpc::CallbackServerContext* context,
                                       const v1::ListPicksRequest* request,
                                       v1::ListPicksResponse* response) override;
+  grpc::ServerUnaryReactor* AcknowledgeFault(grpc::CallbackServerContext* context,
+                                             const v1::AcknowledgeFaultRequest* request,
+                                             v1::AcknowledgeFaultResponse* response) override;
 
  private:
-  const CellController* const cell_;
+  CellController* const cell_;
 };
 
 // The proto forms of the controller's snapshot and records.
@@ -43,7 +46,7 @@ class StatusServer {
 
  private:
   friend absl::StatusOr<std::unique_ptr<StatusServer>> StartStatusServer(
-      const std::string& listen_address, const CellController* cell);
+      const std::string& listen_address, CellController* cell);
   std::unique_ptr<StatusServiceImpl> service_;
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
@@ -52,6 +55,6 @@ class StatusServer {
 // Listens on `listen_address` (host:port; port 0 picks one). UNAVAILABLE
 // when the address cannot be bound.
 absl::StatusOr<std::unique_ptr<StatusServer>> StartStatusServer(const std::string& listen_address,
-                                                                const CellController* cell);
+                                                                CellController* cell);
 
 }  // namespace cornerpose::robot_client

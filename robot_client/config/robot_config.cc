@@ -165,6 +165,17 @@ absl::Status RobotClientOptions::Validate() const {
       !s.ok()) {
     return s;
   }
+  if (absl::Status s = CheckPositive("robot.rtde_max_age_s", robot.rtde_max_age_s, 10.0); !s.ok()) {
+    return s;
+  }
+  if (absl::Status s = CheckPositive("robot.read_timeout_s", robot.read_timeout_s, 60.0); !s.ok()) {
+    return s;
+  }
+  if (absl::Status s =
+          CheckPositive("robot.stop_confirm_timeout_s", robot.stop_confirm_timeout_s, 60.0);
+      !s.ok()) {
+    return s;
+  }
   if (absl::Status s = CheckRigid("base_pose_camera", base_T_camera); !s.ok()) return s;
   for (absl::Status s : {workspace.Validate(), selection.Validate(), gripper.Validate(),
                          waypoints.Validate(), place_pattern.Validate(), motion.Validate()}) {

@@ -50,6 +50,16 @@ struct RobotConnectionOptions {
   double rtde_frequency_hz = 125.0;
   // Each connection attempt and handshake, seconds; > 0.
   double connect_timeout_s = 5.0;
+  // RTDE state older than this stops the cell, seconds; in (0, 10].
+  double rtde_max_age_s = 0.1;
+  // A primary / RTDE link silent this long is taken as lost, seconds; in
+  // (0, 60].
+  double read_timeout_s = 1.0;
+  // Bring the arm up at start without an operator's acknowledgement.
+  bool bring_up_at_start = false;
+  // Wait for a program stopped through the dashboard to be reported
+  // stopped, seconds; in (0, 60].
+  double stop_confirm_timeout_s = 3.0;
 };
 
 // An axis-aligned box in the base frame. Every commanded TCP position must

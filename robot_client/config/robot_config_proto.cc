@@ -64,6 +64,12 @@ absl::Status RobotFromProto(const v1::RobotConnectionConfig& robot, RobotConnect
   }
   if (robot.has_rtde_frequency_hz()) r->rtde_frequency_hz = robot.rtde_frequency_hz();
   if (robot.has_connect_timeout_s()) r->connect_timeout_s = robot.connect_timeout_s();
+  if (robot.has_rtde_max_age_s()) r->rtde_max_age_s = robot.rtde_max_age_s();
+  if (robot.has_read_timeout_s()) r->read_timeout_s = robot.read_timeout_s();
+  if (robot.has_stop_confirm_timeout_s()) {
+    r->stop_confirm_timeout_s = robot.stop_confirm_timeout_s();
+  }
+  r->bring_up_at_start = robot.bring_up_at_start();
   return absl::OkStatus();
 }
 

@@ -1,5 +1,7 @@
 #include "robot_client/ur/primary_client.h"
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
 #include "robot_client/ur/dashboard.h"
 
@@ -39,11 +41,15 @@ const char* ProgramOutcomeName(ProgramOutcome::Kind kind) {
       return "connection lost";
     case ProgramOutcome::kTimeout:
       return "timeout";
+    case ProgramOutcome::kUnfinished:
+      return "stopped without its done message";
+    case ProgramOutcome::kCancelled:
+      return "cancelled";
   }
   return "unknown";
 }
 
-PrimaryClient::PrimaryClient() = default;
+PrimaryClient::PrimaryClient(PrimaryClientOptions options) : options_(options) {}
 
 PrimaryClient::~PrimaryClient() { Stop(); }
 
@@ -96,9 +102,15 @@ void PrimaryClient::ReadLoop(TcpConnection* connection) {
   PrimaryFramer framer;
   absl::Status status;
   while (status.ok()) {
-    absl::StatusOr<std::string> bytes = connection->Read(1 << 16, absl::InfiniteDuration());
+    absl::StatusOr<std::string> bytes = connection->Read(1 << 16, options_.read_timeout);
     if (!bytes.ok()) {
       status = bytes.status();
+      if (absl::IsDeadlineExceeded(status)) {
+        // Open but silent: a half-open link or a hung controller.
+        status = absl::UnavailableError(
+            absl::StrCat("primary interface silent for ", absl::FormatDuration(options_.read_timeout),
+                         " (link half-open or controller hung)"));
+      }
       break;
     }
     framer.Append(*bytes);
@@ -154,7 +166,15 @@ absl::Status PrimaryClient::SendScript(absl::string_view script) {
 }
 
 ProgramOutcome PrimaryClient::WaitForProgram(absl::string_view name, absl::Duration timeout) {
+  ProgramWait wait;
+  wait.timeout = timeout;
+  return WaitForProgram(name, wait);
+}
+
+ProgramOutcome PrimaryClient::WaitForProgram(absl::string_view name, const ProgramWait& wait) {
+  const absl::Duration timeout = wait.timeout;
   const absl::Time deadline = absl::Now() + timeout;
+  bool done_seen = false;
   ProgramOutcome outcome;
   std::unique_lock<std::mutex> lock(mutex_);
   // Only states received after the script was sent: one from before may
@@ -169,12 +189,19 @@ ProgramOutcome PrimaryClient::WaitForProgram(absl::string_view name, absl::Durat
         if (key->text != name) continue;
         if (key->title == kStarted) outcome.started = true;
         if (key->title == kStopped) {
-          outcome.kind = ProgramOutcome::kCompleted;
-          outcome.detail = absl::StrCat("program ", name, " stopped");
+          if (wait.done_text.empty() || done_seen) {
+            outcome.kind = ProgramOutcome::kCompleted;
+            outcome.detail = absl::StrCat("program ", name, " stopped");
+          } else {
+            outcome.kind = ProgramOutcome::kUnfinished;
+            outcome.detail = absl::StrCat("program ", name, " stopped without its done message '",
+                                          wait.done_text, "'");
+          }
           return outcome;
         }
       } else if (const auto* text = std::get_if<TextMessage>(&package)) {
         outcome.text_messages.push_back(text->text);
+        if (!wait.done_text.empty() && text->text == wait.done_text) done_seen = true;
       } else if (const auto* e = std::get_if<RuntimeExceptionMessage>(&package)) {
         outcome.kind = ProgramOutcome::kRuntimeException;
         outcome.detail = absl::StrCat("line ", e->line, ", column ", e->column, ": ", e->text);
@@ -218,7 +245,21 @@ ProgramOutcome PrimaryClient::WaitForProgram(absl::string_view name, absl::Durat
                        " after ", absl::FormatDuration(timeout));
       return outcome;
     }
-    changed_.wait_until(lock, absl::ToChronoTime(deadline));
+    if (wait.cancel) {
+      // The check may take other locks (the RTDE client's): not under ours.
+      lock.unlock();
+      std::optional<std::string> reason = wait.cancel();
+      lock.lock();
+      if (reason) {
+        outcome.kind = ProgramOutcome::kCancelled;
+        outcome.detail = *std::move(reason);
+        return outcome;
+      }
+      if (!messages_.empty() || state_count_ != checked_state || !connected_) continue;
+      changed_.wait_until(lock, absl::ToChronoTime(std::min(deadline, absl::Now() + wait.cancel_poll)));
+    } else {
+      changed_.wait_until(lock, absl::ToChronoTime(deadline));
+    }
   }
 }
 

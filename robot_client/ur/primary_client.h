@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -22,7 +23,19 @@
 namespace cornerpose::ur {
 
 struct ProgramOutcome {
-  enum Kind { kCompleted, kRuntimeException, kProtectiveStop, kConnectionLost, kTimeout };
+  enum Kind {
+    kCompleted,
+    kRuntimeException,
+    kProtectiveStop,
+    kConnectionLost,
+    kTimeout,
+    // PROGRAM_XXX_STOPPED without the program's own done message (stopped
+    // from outside, or cut short): where the arm and the box are is unknown.
+    kUnfinished,
+    // The caller's cancel check asked to stop waiting (the program may still
+    // run: the caller stops it).
+    kCancelled,
+  };
   Kind kind = kTimeout;
   // What happened, for logs: the exception text with line/column, the
   // safety mode, the socket error.
@@ -34,13 +47,33 @@ struct ProgramOutcome {
 };
 const char* ProgramOutcomeName(ProgramOutcome::Kind kind);
 
+struct PrimaryClientOptions {
+  // A connection that sends nothing for this long is taken as lost (the
+  // controller sends ROBOT_STATE at 10 Hz, so a silent half-open link shows
+  // within a second). Infinite: never.
+  absl::Duration read_timeout = absl::InfiniteDuration();
+};
+
+// How WaitForProgram decides the program ended well, and when to give up.
+struct ProgramWait {
+  absl::Duration timeout = absl::Seconds(120);
+  // When set, PROGRAM_XXX_STOPPED counts as completed only after a TEXT
+  // message equal to this (the program's last `textmsg`); otherwise it is
+  // kUnfinished.
+  std::string done_text;
+  // Called about every `cancel_poll` while waiting; a returned reason ends
+  // the wait with kCancelled and that reason as the detail.
+  std::function<std::optional<std::string>()> cancel;
+  absl::Duration cancel_poll = absl::Milliseconds(20);
+};
+
 // Thread-safe. Owns a reader thread from Connect until Close / destruction.
 class PrimaryClient {
  public:
   // Robot messages kept for WaitForProgram; older ones are dropped.
   static constexpr size_t kMaxQueuedMessages = 1000;
 
-  PrimaryClient();
+  explicit PrimaryClient(PrimaryClientOptions options = {});
   ~PrimaryClient();
 
   PrimaryClient(const PrimaryClient&) = delete;
@@ -65,6 +98,8 @@ class PrimaryClient {
   // a ROBOT_MODE_DATA received after the last SendScript with the
   // protective- or emergency-stopped flag; kConnectionLost; kTimeout.
   ProgramOutcome WaitForProgram(absl::string_view name, absl::Duration timeout);
+  // The same with a done message and a cancel check (see ProgramWait).
+  ProgramOutcome WaitForProgram(absl::string_view name, const ProgramWait& wait);
 
   // The most recent ROBOT_STATE (sub-packages merged: a field stays until a
   // newer package carries it); nullopt before the first.
@@ -85,6 +120,7 @@ class PrimaryClient {
   void ReadLoop(TcpConnection* connection);
   void Stop();
 
+  const PrimaryClientOptions options_;
   mutable std::mutex mutex_;
   mutable std::condition_variable changed_;
   std::unique_ptr<TcpConnection> connection_;

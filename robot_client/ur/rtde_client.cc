@@ -222,9 +222,14 @@ void RtdeClient::ReadLoop(TcpConnection* connection, RtdeFramer framer, uint8_t 
       break;
     }
     if (!frame->has_value()) {
-      absl::StatusOr<std::string> bytes = connection->Read(1 << 16, absl::InfiniteDuration());
+      absl::StatusOr<std::string> bytes = connection->Read(1 << 16, options_.read_timeout);
       if (!bytes.ok()) {
         status = bytes.status();
+        if (absl::IsDeadlineExceeded(status)) {
+          status = absl::UnavailableError(
+              absl::StrCat("RTDE silent for ", absl::FormatDuration(options_.read_timeout),
+                           " (link half-open or controller hung)"));
+        }
         break;
       }
       framer.Append(*bytes);
@@ -237,6 +242,7 @@ void RtdeClient::ReadLoop(TcpConnection* connection, RtdeFramer framer, uint8_t 
     RtdeState state = latest_.value_or(RtdeState{});
     Decode(*package, state);
     state.sequence = ++sequence;
+    state.received = absl::Now();
     latest_ = state;
     changed_.notify_all();
   }
@@ -264,6 +270,12 @@ absl::StatusOr<RtdeState> RtdeClient::Latest() const {
         absl::StrCat("RTDE: not connected: ", connection_status_.message()));
   }
   if (!latest_) return absl::UnavailableError("RTDE: no data package yet");
+  const absl::Duration age = absl::Now() - latest_->received;
+  if (age > options_.max_age) {
+    return absl::DeadlineExceededError(
+        absl::StrCat("RTDE data stale: the newest package is ", absl::FormatDuration(age),
+                     " old (limit ", absl::FormatDuration(options_.max_age), ")"));
+  }
   return *latest_;
 }
 

@@ -39,12 +39,21 @@ struct RtdeState {
   uint32_t runtime_state = 0;       // 1 stopped, 2 playing, 4 paused
   double speed_scaling = 0.0;
   double target_speed_fraction = 0.0;
+  // When the package arrived (this machine's clock): its age is how stale
+  // the state is.
+  absl::Time received = absl::InfinitePast();
 };
 
 struct RtdeClientOptions {
   // Requested output frequency [Hz]; capped at 125 for a controller older
   // than 5.0 (CB3) and 500 otherwise.
   double frequency = 125.0;
+  // A connection that sends nothing for this long is taken as lost (open
+  // but silent: half-open, or the controller hung). Infinite: never.
+  absl::Duration read_timeout = absl::InfiniteDuration();
+  // Latest() refuses a state older than this (DEADLINE_EXCEEDED): a stalled
+  // stream must not be planned from. Infinite: any age.
+  absl::Duration max_age = absl::InfiniteDuration();
 };
 
 // The output recipe the client requests, in order.
@@ -70,7 +79,8 @@ class RtdeClient {
   // The controller version from the handshake.
   std::optional<UrcontrolVersion> controller_version() const;
 
-  // The newest state; UNAVAILABLE when not connected.
+  // The newest state; UNAVAILABLE when not connected, DEADLINE_EXCEEDED
+  // (with its age) when it is older than options.max_age.
   absl::StatusOr<RtdeState> Latest() const;
   // The first state with sequence > `sequence`; DEADLINE_EXCEEDED, or
   // UNAVAILABLE when the connection is lost.

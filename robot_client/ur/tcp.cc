@@ -184,6 +184,14 @@ absl::StatusOr<TcpConnection> TcpConnection::Connect(absl::string_view host, int
       ::close(fd);
       continue;
     }
+    // Keep-alive: a peer that vanished without a FIN or RST (power cut,
+    // cable pulled) is found in about 4 s even when nothing is written.
+    // The clients' read timeouts catch a peer that is there but silent.
+    const int one = 1, idle_s = 1, interval_s = 1, probes = 3;
+    ::setsockopt(fd, SOL_SOCKET, SO_KEEPALIVE, &one, sizeof(one));
+    ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPIDLE, &idle_s, sizeof(idle_s));
+    ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPINTVL, &interval_s, sizeof(interval_s));
+    ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPCNT, &probes, sizeof(probes));
     return FromFd(fd);
   }
   return last;

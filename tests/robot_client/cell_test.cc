@@ -31,16 +31,14 @@
 #include "robot_client/ur/pose.h"
 #include "server/server.h"
 #include "tests/support/ur_emulator/ur_emulator.h"
+#include "tests/robot_client/cell_fixture.h"
 
 namespace cornerpose::robot_client {
 namespace {
 
 const std::string kSourceDir = CORNERPOSE_SOURCE_DIR;
 const std::string kCellFrames = kSourceDir + "/data/frames/cell";
-const std::string kConfig = kSourceDir + "/deploy/config/robot_client.textproto";
 
-// Simulated seconds per wall second: a pick takes ~15 s simulated.
-constexpr double kTimeScale = 20.0;
 
 struct GroundTruthBox {
   Eigen::Isometry3d camera_T_box = Eigen::Isometry3d::Identity();
@@ -108,121 +106,7 @@ FaceFit FitToFace(const Eigen::Isometry3d& base_T_tcp, const Eigen::Isometry3d& 
 // The digital tool output 0 (the suction) after a step.
 bool SuctionOn(const ur_emulator::ExecutedStep& step) { return (step.tool_outputs & 1u) != 0; }
 
-class CellTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    server::ServerOptions server_options;
-    server_options.listen_address = "127.0.0.1:0";
-    server_options.sources = {{.name = "cell", .directory = kCellFrames, .fps = 10, .loop = true}};
-    absl::StatusOr<std::unique_ptr<server::RunningServer>> server =
-        server::StartServer(server_options);
-    ASSERT_TRUE(server.ok()) << server.status();
-    server_ = *std::move(server);
-
-    ur_emulator::UrEmulatorOptions emulator_options;
-    emulator_options.time_scale = kTimeScale;
-    emulator_options.protective_stop_unlock_delay_s = 1.0;
-    absl::StatusOr<std::unique_ptr<ur_emulator::UrEmulator>> emulator =
-        ur_emulator::UrEmulator::Start(emulator_options);
-    ASSERT_TRUE(emulator.ok()) << emulator.status();
-    emulator_ = *std::move(emulator);
-
-    absl::StatusOr<RobotClientOptions> options = LoadRobotClientConfig(kConfig);
-    ASSERT_TRUE(options.ok()) << options.status();
-    options_ = *std::move(options);
-    options_.perception.server_address = "127.0.0.1:" + std::to_string(server_->port());
-    options_.perception.source = "cell";
-    options_.robot.host = "127.0.0.1";
-    options_.robot.dashboard_port = emulator_->dashboard_port();
-    options_.robot.primary_port = emulator_->primary_port();
-    options_.robot.rtde_port = emulator_->rtde_port();
-    options_.status_listen_address = "127.0.0.1:0";
-  }
-
-  void TearDown() override {
-    if (cell_) cell_->Stop();
-    if (subscriber_) subscriber_->Stop();
-    if (cell_thread_.joinable()) cell_thread_.join();
-    status_server_.reset();
-    cell_.reset();
-    subscriber_.reset();
-  }
-
-  // Starts the daemon's parts as cornerpose_robot_client does.
-  void StartCell() {
-    PerceptionSubscriberOptions perception;
-    perception.server = options_.perception.server_address;
-    perception.source = options_.perception.source;
-    perception.box_model = options_.perception.box_model;
-    perception.box = options_.perception.box;
-    perception.initial_backoff = absl::Milliseconds(100);
-    perception.max_backoff = absl::Milliseconds(500);
-    subscriber_ = std::make_unique<PerceptionSubscriber>(perception);
-    CellControllerOptions controller;
-    controller.retry_interval = absl::Milliseconds(100);
-    controller.program_timeout = absl::Seconds(60);
-    CellCallbacks callbacks;
-    callbacks.on_program = [this](const std::string& name, const std::string& text) {
-      std::lock_guard<std::mutex> lock(programs_mutex_);
-      rendered_programs_.push_back(name + "\n" + text);
-    };
-    cell_ = std::make_unique<CellController>(options_, controller, subscriber_.get(), callbacks);
-    absl::StatusOr<std::unique_ptr<StatusServer>> status =
-        StartStatusServer(options_.status_listen_address, cell_.get());
-    ASSERT_TRUE(status.ok()) << status.status();
-    status_server_ = *std::move(status);
-    channel_ = grpc::CreateChannel("127.0.0.1:" + std::to_string(status_server_->port()),
-                                   grpc::InsecureChannelCredentials());
-    status_stub_ = v1::RobotClientService::NewStub(channel_);
-    subscriber_->Start();
-    cell_thread_ = std::thread([this] { cell_->Run(); });
-  }
-
-  // The cell's status through the status service.
-  v1::CellStatus GetStatus() {
-    grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
-    v1::CellStatus status;
-    const grpc::Status s = status_stub_->GetCellStatus(&context, {}, &status);
-    EXPECT_TRUE(s.ok()) << s.error_message();
-    return status;
-  }
-
-  // Polls the status service until `predicate` holds; false after `timeout`.
-  bool WaitForStatus(const std::function<bool(const v1::CellStatus&)>& predicate,
-                     absl::Duration timeout, v1::CellStatus* last = nullptr) {
-    const absl::Time deadline = absl::Now() + timeout;
-    v1::CellStatus status;
-    while (absl::Now() < deadline) {
-      status = GetStatus();
-      if (predicate(status)) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    if (last) *last = status;
-    return predicate(status);
-  }
-
-  std::vector<v1::PickRecord> ListPicks() {
-    grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
-    v1::ListPicksResponse response;
-    const grpc::Status s = status_stub_->ListPicks(&context, {}, &response);
-    EXPECT_TRUE(s.ok()) << s.error_message();
-    return {response.picks().begin(), response.picks().end()};
-  }
-
-  RobotClientOptions options_;
-  std::unique_ptr<server::RunningServer> server_;
-  std::unique_ptr<ur_emulator::UrEmulator> emulator_;
-  std::unique_ptr<PerceptionSubscriber> subscriber_;
-  std::unique_ptr<CellController> cell_;
-  std::unique_ptr<StatusServer> status_server_;
-  std::shared_ptr<grpc::Channel> channel_;
-  std::unique_ptr<v1::RobotClientService::Stub> status_stub_;
-  std::thread cell_thread_;
-  std::mutex programs_mutex_;
-  std::vector<std::string> rendered_programs_;
-};
+class CellTest : public testing::CellFixture {};
 
 TEST_F(CellTest, PicksRealBoxesAndPlacesThemSlotBySlot) {
   constexpr int kPicks = 4;
@@ -302,6 +186,9 @@ TEST_F(CellTest, PicksRealBoxesAndPlacesThemSlotBySlot) {
       const double previous_end_ns =
           static_cast<double>(previous.start_time_unix_nanos()) + previous.program_s() * 1e9;
       EXPECT_GT(static_cast<double>(pick.capture_time_unix_nanos()), previous_end_ns);
+      // And by the source's own frame order: past the frame in flight when
+      // the previous move ended.
+      EXPECT_GE(pick.frame_id(), previous.frame_id() + 2);
     }
   }
 
@@ -422,6 +309,24 @@ TEST_F(CellTest, DroppedControllerConnectionsAreReopened) {
                             absl::Seconds(120)));
   emulator_->DropConnections();
   v1::CellStatus status;
+  ASSERT_TRUE(WaitForStatus(
+      [](const v1::CellStatus& s) {
+        return s.state() == v1::CELL_STATE_FINISHED || s.unknown_pick_id() != 0;
+      },
+      absl::Seconds(120), &status))
+      << status.DebugString();
+  if (status.unknown_pick_id() != 0) {
+    // The drop hit a running pick: its end is unknown, the daemon stopped
+    // the program on reconnect and sends nothing until an operator answers.
+    EXPECT_EQ(status.state(), v1::CELL_STATE_STOPPED);
+    ASSERT_TRUE(
+        WaitForStatus([](const v1::CellStatus& s) { return s.awaiting_acknowledgement(); },
+                      absl::Seconds(30), &status))
+        << status.DebugString();
+    EXPECT_FALSE(emulator_->Snapshot().program_running);
+    EXPECT_TRUE(NoProgramSentFor(absl::Seconds(1)));
+    ASSERT_TRUE(Acknowledge("ada", /*unknown_pick_placed=*/false).ok());
+  }
   ASSERT_TRUE(
       WaitForStatus([](const v1::CellStatus& s) { return s.state() == v1::CELL_STATE_FINISHED; },
                     absl::Seconds(120), &status))

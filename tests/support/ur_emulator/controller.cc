@@ -211,6 +211,7 @@ void Controller::SubmitScript(const std::string& text) {
 
 bool Controller::PowerOn() {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (safety_mode_ == kSafetyModeRobotEmergencyStop) return false;
   if (robot_mode_ == kRobotModePowerOff) {
     robot_mode_ = kRobotModePowerOn;
     mode_change_ = {SimTimeLocked() + options_.power_on_delay_s, kRobotModeIdle};
@@ -283,6 +284,36 @@ void Controller::TriggerProtectiveStopLocked() {
 void Controller::TriggerProtectiveStop() {
   std::lock_guard<std::mutex> lock(mutex_);
   TriggerProtectiveStopLocked();
+}
+
+void Controller::SetHangPrograms(bool hang) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  hang_programs_ = hang;
+  changed_.notify_all();
+}
+
+void Controller::TriggerEmergencyStop() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  SetSafetyModeLocked(kSafetyModeRobotEmergencyStop);
+  // The arm loses power: motion, the scheduled mode change and the tool
+  // outputs go with it.
+  robot_mode_ = kRobotModePowerOff;
+  mode_change_.reset();
+  brake_release_requested_ = false;
+  tool_outputs_ = 0;
+  if (program_running_) abort_ = Abort::kStopped;
+  pending_.reset();
+  qd_ = {};
+  q_target_ = q_;
+  changed_.notify_all();
+}
+
+void Controller::ResetEmergencyStop() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (safety_mode_ != kSafetyModeRobotEmergencyStop) return;
+  // As on the real controller: NORMAL again, but still powered off.
+  SetSafetyModeLocked(kSafetyModeNormal);
+  changed_.notify_all();
 }
 
 RobotSnapshot Controller::SnapshotLocked() const {
@@ -429,7 +460,13 @@ void Controller::RunProgramLocked(std::unique_lock<std::mutex>& lock, Pending pe
   changed_.notify_all();
 
   Outcome outcome;
-  for (const ScriptCall& call : pending.program.calls) {
+  for (size_t i = 0; i < pending.program.calls.size(); ++i) {
+    const ScriptCall& call = pending.program.calls[i];
+    // Fault: a program that never ends stalls before its last statement
+    // (the daemon's done message) until it is stopped or the fault cleared.
+    if (i + 1 == pending.program.calls.size()) {
+      changed_.wait(lock, [&] { return !hang_programs_ || abort_ != Abort::kNone || shutdown_; });
+    }
     if (abort_ != Abort::kNone) {
       outcome = AbortOutcomeLocked();
       break;

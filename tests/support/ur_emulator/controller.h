@@ -30,6 +30,7 @@ inline constexpr int kRobotModeIdle = 5;
 inline constexpr int kRobotModeRunning = 7;
 inline constexpr int kSafetyModeNormal = 1;
 inline constexpr int kSafetyModeProtectiveStop = 3;
+inline constexpr int kSafetyModeRobotEmergencyStop = 7;
 
 // One executed statement.
 struct ExecutedStep {
@@ -135,6 +136,15 @@ class Controller {
   // Halts motion at once, ends the program kProtectiveStop, safety mode
   // PROTECTIVE_STOP; robot mode stays as it was.
   void TriggerProtectiveStop();
+  // Fault: while set, every program stalls before its last statement and
+  // runs until stopped (a program that never ends).
+  void SetHangPrograms(bool hang);
+  // Emergency stop: safety mode ROBOT_EMERGENCY_STOP, the arm powered off
+  // (program aborted, tool outputs off); `power on` is refused until
+  // ResetEmergencyStop, which makes the safety mode NORMAL and leaves the
+  // arm POWER_OFF.
+  void TriggerEmergencyStop();
+  void ResetEmergencyStop();
 
   RobotSnapshot Snapshot() const;
   std::vector<ExecutedProgram> Programs() const;
@@ -209,6 +219,7 @@ class Controller {
   // A scheduled mode change (power on -> IDLE, brake release -> RUNNING).
   std::optional<std::pair<double, int>> mode_change_;
   bool brake_release_requested_ = false;
+  bool hang_programs_ = false;
   std::optional<Pending> pending_;
   Abort abort_ = Abort::kNone;
   bool shutdown_ = false;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <thread>
 
 #include "absl/strings/str_cat.h"
 #include "robot_client/ur/dashboard.h"
@@ -110,6 +111,10 @@ void Servers::DropConnections() {
 void Servers::ServeDashboard(ur::TcpConnection& connection, const std::atomic<bool>& stopping) {
   if (!connection.WriteAll(absl::StrCat(ur::kDashboardBanner, "\n")).ok()) return;
   while (!stopping) {
+    if (silent_) {
+      std::this_thread::sleep_for(absl::ToChronoMilliseconds(kPoll));
+      continue;
+    }
     auto line = connection.ReadLine(kPoll);
     if (!line.ok()) {
       if (IsTimeout(line.status())) continue;
@@ -131,6 +136,10 @@ void Servers::ServePrimary(ur::TcpConnection& connection, const std::atomic<bool
     auto next_state = std::chrono::steady_clock::now();
     bool ok = connection.WriteAll(EncodePrimaryVersion(controller_.options())).ok();
     while (ok && !done && !stopping) {
+      if (silent_) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        continue;
+      }
       auto now = std::chrono::steady_clock::now();
       if (now >= next_state) {
         ok = connection.WriteAll(EncodePrimaryState(controller_.Snapshot())).ok();
@@ -171,8 +180,12 @@ void Servers::ServeRtde(ur::TcpConnection& connection, const std::atomic<bool>& 
   ur::RtdeFramer framer;
   auto next_package = std::chrono::steady_clock::now();
   while (!stopping) {
+    if (silent_) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      continue;
+    }
     absl::Duration timeout = kPoll;
-    if (session.streaming()) {
+    if (session.streaming() && !rtde_stalled_) {
       const auto now = std::chrono::steady_clock::now();
       if (now >= next_package) {
         if (!connection.WriteAll(session.DataPackage(controller_.Snapshot())).ok()) return;

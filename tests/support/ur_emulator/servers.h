@@ -60,6 +60,11 @@ class Servers {
   explicit Servers(Controller& controller) : controller_(controller) {}
   absl::Status Start();
   void DropConnections();
+  // Faults. Silent: every connection (and every new one) stays open but
+  // sends nothing and answers nothing (a half-open link, a hung
+  // controller). RTDE stall: RTDE data packages stop; the rest goes on.
+  void SetSilent(bool silent) { silent_ = silent; }
+  void SetRtdeStalled(bool stalled) { rtde_stalled_ = stalled; }
 
   int dashboard_port() const { return dashboard_.port(); }
   int primary_port() const { return primary_.port(); }
@@ -71,6 +76,8 @@ class Servers {
   void ServeRtde(ur::TcpConnection& connection, const std::atomic<bool>& stopping);
 
   Controller& controller_;
+  std::atomic<bool> silent_{false};
+  std::atomic<bool> rtde_stalled_{false};
   TcpServer dashboard_;
   TcpServer primary_;
   TcpServer rtde_;

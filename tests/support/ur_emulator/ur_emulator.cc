@@ -35,6 +35,8 @@ int UrEmulator::primary_port() const { return servers_->primary_port(); }
 int UrEmulator::rtde_port() const { return servers_->rtde_port(); }
 
 void UrEmulator::DropConnections() { servers_->DropConnections(); }
+void UrEmulator::SetLinksSilent(bool silent) { servers_->SetSilent(silent); }
+void UrEmulator::SetRtdeStalled(bool stalled) { servers_->SetRtdeStalled(stalled); }
 
 bool UrEmulator::WaitForProgramsFinished(size_t count, absl::Duration timeout) const {
   return WaitFor([count](const RobotSnapshot& s) { return s.programs_finished >= count; }, timeout);

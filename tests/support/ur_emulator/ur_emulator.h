@@ -49,6 +49,14 @@ class UrEmulator {
   // every client socket on all three ports; new connections are accepted.
   void TriggerProtectiveStop() { controller_->TriggerProtectiveStop(); }
   void DropConnections();
+  // More faults: every link open but silent (see Servers::SetSilent); the
+  // RTDE stream stalled; programs that never end; emergency stop and its
+  // reset (see Controller). Each holds until called again with false.
+  void SetLinksSilent(bool silent);
+  void SetRtdeStalled(bool stalled);
+  void SetHangPrograms(bool hang) { controller_->SetHangPrograms(hang); }
+  void TriggerEmergencyStop() { controller_->TriggerEmergencyStop(); }
+  void ResetEmergencyStop() { controller_->ResetEmergencyStop(); }
 
   // State, thread-safe.
   RobotSnapshot Snapshot() const { return controller_->Snapshot(); }
