@@ -22,3 +22,5 @@ add_executable(cell_sim ${CORNERPOSE_CELL_SIM_DIR}/cell_sim_main.cc)
 target_link_libraries(cell_sim PRIVATE cornerpose_cell_sim absl::flags absl::flags_parse
                       absl::flags_usage nlohmann_json::nlohmann_json)
 cornerpose_warnings(cell_sim)
+cornerpose_test(cell_world_test SOURCES ${PROJECT_SOURCE_DIR}/tests/cell_sim/cell_world_test.cc
+                LIBS cornerpose_cell_sim)

@@ -32,7 +32,7 @@ ABSL_FLAG(uint32_t, seed, 1, "Layout and noise seed.");
 ABSL_FLAG(std::string, sensor, "kinect", "Depth sensor model: kinect or ideal.");
 ABSL_FLAG(std::string, frames_dir, "out/sim/frames", "Where the camera writes its frames.");
 ABSL_FLAG(double, camera_max_fps, 10, "Most renders a second (wall); only when the world changed.");
-ABSL_FLAG(double, camera_height, 1.8, "Camera height above the floor, metres.");
+ABSL_FLAG(double, camera_height, 2.0, "Camera height above the floor, metres.");
 ABSL_FLAG(std::string, host, "127.0.0.1", "Address the emulator listens on.");
 ABSL_FLAG(int, dashboard_port, 29999, "Dashboard server port.");
 ABSL_FLAG(int, primary_port, 30001, "Primary interface port.");

@@ -278,6 +278,8 @@ void CellWorld::GripLocked(const ur_emulator::ArmState& state) {
     }
   }
   held_ = best;
+  held_moved_ = false;
+  grip_box_position_ = box.world_T_box.translation();
   held_badly_ = !best_sealed;
   grip_tcp_z_ = tcp.translation().z();
   tcp_T_held_ = tcp.inverse() * box.world_T_box;
@@ -301,9 +303,14 @@ void CellWorld::ReleaseLocked(const Eigen::Isometry3d& tcp) {
   const double fall = before - centre.z();
   if (layout_.place_area.Contains(centre)) {
     box.state = BoxState::kPlaced;
-    if (current_ && current_->result == PickResult::kPlaced && fall > 0.03) {
-      current_->detail += absl::StrFormat("; fell %.0f mm onto the place area", 1000 * fall);
+    // Let go well above where it lands (the box was taken for another size
+    // or orientation): it reached the place area, but dropped.
+    if (current_ && current_->result == PickResult::kPlaced && fall > options_.max_set_down_fall_m) {
+      current_->result = PickResult::kDropped;
+      current_->detail += absl::StrFormat("; let go %.0f mm above the place area and fell onto it",
+                                          1000 * fall);
     }
+    ChangedLocked();
     return;
   }
   box.state = layout_.pick_area.Contains(centre) ? BoxState::kInPile : BoxState::kDropped;
@@ -365,11 +372,17 @@ std::optional<std::string> CellWorld::OnStep(const ur_emulator::ArmState& state)
   if (held_ >= 0) {
     SimBox& box = boxes_[static_cast<size_t>(held_)];
     box.world_T_box = tcp * tcp_T_held_;
-    ChangedLocked();
+    // The camera needs a new frame once the box has left its place (and
+    // again when it is set down), not at every step of the way.
+    if (!held_moved_ && (box.world_T_box.translation() - grip_box_position_).norm() > 0.01) {
+      held_moved_ = true;
+      ChangedLocked();
+    }
     if (held_badly_ && tcp.translation().z() - grip_tcp_z_ > options_.suction.slip_lift_m) {
       const int lost = held_;
       held_ = -1;
       SettleLocked(lost);
+      ChangedLocked();
       box.state = layout_.pick_area.Contains(box.world_T_box.translation()) ? BoxState::kInPile
                                                                             : BoxState::kDropped;
       if (current_) {
@@ -381,6 +394,9 @@ std::optional<std::string> CellWorld::OnStep(const ur_emulator::ArmState& state)
   if (!options_.collision.enabled) return std::nullopt;
   std::optional<std::string> contact = ContactLocked(state);
   if (contact) {
+    *contact += absl::StrFormat(" (joints %.3f %.3f %.3f %.3f %.3f %.3f)", state.joints[0],
+                                state.joints[1], state.joints[2], state.joints[3],
+                                state.joints[4], state.joints[5]);
     ++collisions_;
     if (current_) {
       current_->result = PickResult::kCollision;
@@ -422,8 +438,15 @@ void CellWorld::OnProgramEnd(const std::string& program, bool completed, double 
     }
     version = version_;
   }
-  WaitForRendered(version, options_.camera_sync_timeout);
-  std::this_thread::sleep_for(absl::ToChronoNanoseconds(options_.frame_settle));
+  bool camera = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    camera = rendered_version_ > 0;  // a camera follows this world
+  }
+  if (camera) {
+    WaitForRendered(version, options_.camera_sync_timeout);
+    std::this_thread::sleep_for(absl::ToChronoNanoseconds(options_.frame_settle));
+  }
   std::function<void(const PickEvent&, const WorldSummary&)> listener;
   std::optional<PickEvent> event;
   {

@@ -67,6 +67,9 @@ struct CellWorldOptions {
   // source polling the camera's directory has picked the new frame up.
   absl::Duration camera_sync_timeout = absl::Seconds(10);
   absl::Duration frame_settle = absl::Milliseconds(150);
+  // A box let go higher than this above where it comes to rest was dropped,
+  // not set down, m, >= 0.
+  double max_set_down_fall_m = 0.02;
 
   absl::Status Validate() const;
 };
@@ -165,6 +168,8 @@ class CellWorld final : public ur_emulator::ArmWorld {
   bool vacuum_ = false;
   int held_ = -1;
   bool held_badly_ = false;
+  bool held_moved_ = false;
+  Eigen::Vector3d grip_box_position_ = Eigen::Vector3d::Zero();
   double grip_tcp_z_ = 0.0;
   Eigen::Isometry3d tcp_T_held_ = Eigen::Isometry3d::Identity();
   int collisions_ = 0;

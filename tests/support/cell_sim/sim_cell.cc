@@ -44,8 +44,10 @@ std::vector<testing::SceneBox> PalletLoad(const SimCellOptions& cell, const SimL
   for (int layer = 0; layer < load.layers; ++layer) {
     const bool turned = load.pattern == "interlock" && layer % 2 == 1;
     const double along_x = turned ? d.b : d.l, along_y = turned ? d.l : d.b;
-    const int cols = static_cast<int>((cell.pick_length_m + load.gap_m) / (along_x + load.gap_m));
-    const int rows = static_cast<int>((cell.pick_width_m + load.gap_m) / (along_y + load.gap_m));
+    const int cols =
+        static_cast<int>((cell.pick_length_m + load.gap_m) / (along_x + load.gap_m) + 1e-6);
+    const int rows =
+        static_cast<int>((cell.pick_width_m + load.gap_m) / (along_y + load.gap_m) + 1e-6);
     *per_layer_max = std::max(*per_layer_max, cols * rows);
     const double z = testing::kEurPalletHeight + (layer + 0.5) * d.h;
     for (int r = 0; r < rows; ++r) {
@@ -79,7 +81,7 @@ absl::StatusOr<std::vector<testing::SceneBox>> HeapLoad(const SimCellOptions& ce
       }
     }
     const Eigen::Vector3d size = hi - lo;
-    if (size.x() > cell.pick_length_m - 2 * margin_m || size.y() > cell.pick_width_m - 2 * margin_m) {
+    if (size.x() > cell.pick_length_m - 2 * margin_m || size.y() > cell.heap_width_m - 2 * margin_m) {
       continue;
     }
     const Eigen::Vector3d shift(-0.5 * (lo.x() + hi.x()), -0.5 * (lo.y() + hi.y()), deck_z);
@@ -94,7 +96,7 @@ absl::StatusOr<std::vector<testing::SceneBox>> HeapLoad(const SimCellOptions& ce
 // A bin standing on the pallet deck: a floor and four walls around the area.
 std::vector<testing::SupportPart> Bin(const SimCellOptions& cell, double wall_height_m) {
   const double t = 0.02, floor_top = testing::kEurPalletHeight + t;
-  const double L = cell.pick_length_m + 2 * t, W = cell.pick_width_m + 2 * t;
+  const double L = cell.pick_length_m + 2 * t, W = cell.heap_width_m + 2 * t;
   const double z_wall = floor_top + 0.5 * wall_height_m;
   return {
       {"bin_floor", {L, W, t}, At({0, 0, testing::kEurPalletHeight + 0.5 * t})},
@@ -124,6 +126,9 @@ absl::Status SimCellOptions::Validate() const {
   }
   if (!(pick_width_m > 0.1 && pick_width_m <= 0.9)) {
     return Bad("SimCellOptions.pick_width_m", pick_width_m, "(0.1, 0.9]");
+  }
+  if (!(heap_width_m > 0.1 && heap_width_m <= 0.9)) {
+    return Bad("SimCellOptions.heap_width_m", heap_width_m, "(0.1, 0.9]");
   }
   return absl::OkStatus();
 }
@@ -168,7 +173,7 @@ absl::StatusOr<SimCell> MakeSimCell(const SimCellOptions& cell, const SimLoadOpt
   layout.supports.push_back({"pedestal",
                              {0.18, 0.18, cell.pedestal_height_m},
                              At({0, cell.base_y_m, 0.5 * cell.pedestal_height_m})});
-  layout.pick_area = {Eigen::Vector3d(-0.7, -0.42, 0.0), Eigen::Vector3d(0.7, 0.42, 3.0)};
+  layout.pick_area = {Eigen::Vector3d(-0.7, -0.47, 0.0), Eigen::Vector3d(0.7, 0.47, 3.0)};
   layout.place_area = {Eigen::Vector3d(-0.7, place_y - 0.42, 0.0),
                        Eigen::Vector3d(0.7, place_y + 0.42, 3.0)};
 
@@ -198,8 +203,8 @@ absl::StatusOr<SimCell> MakeSimCell(const SimCellOptions& cell, const SimLoadOpt
   // The place pattern: the largest grid with 1 cm between boxes on the
   // place pallet's area, flat (the face picked looks up again), far row first.
   const double px = d.l + 0.01, py = d.b + 0.01;
-  out.place_columns = std::max(1, static_cast<int>((cell.pick_length_m + 0.01) / px));
-  out.place_rows = std::max(1, static_cast<int>((cell.pick_width_m + 0.02) / py));
+  out.place_columns = std::max(1, static_cast<int>((cell.pick_length_m + 0.01) / px + 1e-6));
+  out.place_rows = std::max(1, static_cast<int>((cell.pick_width_m + 0.02) / py + 1e-6));
   const int per_place_layer = out.place_rows * out.place_columns;
   const int count = static_cast<int>(out.boxes.size());
   out.place_layers = (count + per_place_layer - 1) / per_place_layer;
@@ -213,7 +218,7 @@ absl::StatusOr<SimCell> MakeSimCell(const SimCellOptions& cell, const SimLoadOpt
                                      testing::kEurPalletHeight);
   out.place_origin_base = layout.world_T_base.inverse() * origin_world;
   out.lift_height_m =
-      std::max(0.25, (load.kind == "pallet" ? d.h : d.vec().maxCoeff()) + 0.10);
+      std::max(0.35, (load.kind == "pallet" ? d.h : d.vec().maxCoeff()) + 0.20);
   return out;
 }
 
@@ -224,18 +229,18 @@ absl::StatusOr<std::string> RobotClientConfigText(const SimCell& cell, const std
   const Eigen::Quaterniond q(base_T_camera.linear());
   const Eigen::Vector3d c = base_T_camera.translation();
   const double floor_z = -layout.world_T_base.translation().z();
-  // The clear pose: the tool 0.25 m above the base plate, 0.3 m towards the
-  // place pallet, pointing down; joints from the emulator's home pose.
-  Eigen::Isometry3d clear = Eigen::Isometry3d::Identity();
-  clear.linear() << 1, 0, 0, 0, -1, 0, 0, 0, -1;
-  clear.translation() = Eigen::Vector3d(0.0, -0.30, 0.25);
-  const Eigen::Isometry3d flange_T_tcp(Eigen::Translation3d(0, 0, 0.10));
-  absl::StatusOr<ur::Joints> clear_q =
-      ur::InverseKinematics(layout.arm, clear * flange_T_tcp.inverse(),
-                            ur::Joints{0.0, -1.571, 1.571, -1.571, -1.571, 0.0});
-  if (!clear_q.ok()) return clear_q.status();
+  // The clear pose: the emulator's home pose turned to face the pick
+  // pallet (upper arm straight up, elbow up, the tool 0.39 m above the base
+  // plate over the pallet's near edge, pointing down). The daemon's free
+  // moves take the inverse kinematics solution nearest the current joints;
+  // from here that is the elbow-up solution in front of the robot for every
+  // box, where from a pose beside or behind the robot it is, for some boxes,
+  // the solution reaching back over the shoulder, which sweeps the forearm
+  // through the load. (The simulated camera does not render the arm; a real
+  // one would see it here.)
+  const ur::Joints clear_q{-M_PI / 2, -1.571, 1.571, -1.571, -1.571, 0.0};
   std::string joints;
-  for (int i = 0; i < 6; ++i) absl::StrAppend(&joints, i ? ", " : "", Num((*clear_q)[i]));
+  for (int i = 0; i < 6; ++i) absl::StrAppend(&joints, i ? ", " : "", Num(clear_q[i]));
 
   std::string text = absl::StrCat(
       "# cornerpose_robot_client configuration for the simulated cell (written by\n",
@@ -261,7 +266,7 @@ absl::StatusOr<std::string> RobotClientConfigText(const SimCell& cell, const std
       "    rotation_vector { x: 0 y: 0 z: 0 }\n  }\n  suction_output: SUCTION_OUTPUT_KIND_TOOL\n",
       "  suction_output_index: 0\n  grasp_settle_s: 0.3\n  release_s: 0.3\n}\n\n",
       "# The held box rises this far above its grasp (its bottom clears the boxes\n",
-      "# around it by 0.1 m or more) and comes down onto its slot from as high, so\n",
+      "# around it by 0.2 m or more) and comes down onto its slot from as high, so\n",
       "# it never sweeps through the layer it joins.\n",
       "waypoints {\n  approach_distance_m: 0.10\n  retrieve_height_m: ",
       Num(cell.lift_height_m), "\n  place_approach_height_m: ", Num(cell.lift_height_m),
@@ -274,9 +279,11 @@ absl::StatusOr<std::string> RobotClientConfigText(const SimCell& cell, const std
       "\n  spacing_x_m: ", Num(cell.place_spacing_x_m), "\n  spacing_y_m: ",
       Num(cell.place_spacing_y_m), "\n  layer_height_m: ", Num(cell.place_layer_height_m),
       "\n}\n\n",
-      "motion {\n  joint_speed_rad_s: 1.05\n  joint_acceleration_rad_s2: 1.4\n",
+      "# Free moves at two thirds of the UR5e's joint speed limit (pi rad/s).\n",
+      "motion {\n  joint_speed_rad_s: 2.0\n  joint_acceleration_rad_s2: 3.0\n",
       "  linear_speed_m_s: 0.25\n  linear_acceleration_m_s2: 1.0\n}\n\n",
-      "# Tool 0.25 m above the base plate, 0.3 m towards the place pallet, pointing down.\n",
+      "# The home pose facing the pick pallet: tool 0.39 m above the base plate at\n",
+      "# (0.13, 0.49), pointing down, upper arm up, elbow up (see sim_cell.cc).\n",
       "clear_joints_rad: [", joints, "]\n\n",
       "status_listen_address: \"127.0.0.1:50061\"\ndry_run: false\nmax_picks: 0\n");
   return text;

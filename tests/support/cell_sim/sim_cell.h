@@ -24,19 +24,23 @@ namespace cornerpose::cell_sim {
 
 struct SimCellOptions {
   ur::ArmModel arm = ur::ArmModel::kUr5e;
-  // Height of the base plate above the floor, m, [0.3, 1.5]. At 0.6 every
+  // Height of the base plate above the floor, m, [0.3, 1.5]. At 0.65 every
   // grasp of a three-layer carton pallet (grasp faces 0.29-0.59 m above the
-  // floor, 0.3 m below to level with the base) and its straight lift of
-  // 0.25 m stay inside the UR5e's singularity-free reach out to 0.85 m.
-  double pedestal_height_m = 0.6;
+  // floor, 0.36-0.06 m below the base) and its straight lift of 0.35 m stay
+  // inside the UR5e's singularity-free reach out to 0.85 m.
+  double pedestal_height_m = 0.65;
   // World y of the base axis, m (the pick pallet's centre is y = 0), [-1, -0.45].
   double base_y_m = -0.49;
-  // Height of the camera above the floor, m, [1.0, 3.0]. At 1.8 the top of a
-  // three-layer carton pallet is 1.2 m away, the bottom layer 1.5 m.
-  double camera_height_m = 1.8;
+  // Height of the camera above the floor, m, [1.0, 3.0]. At 2.0 the top of a
+  // three-layer carton pallet is 1.4 m away, the bottom layer 1.7 m, and the
+  // place pallet's loads stay out of view.
+  double camera_height_m = 2.0;
   // The pick area's footprint, m (centred on the pick pallet).
-  double pick_length_m = 1.24;
-  double pick_width_m = 0.62;
+  double pick_length_m = 1.25;
+  double pick_width_m = 0.63;
+  // A heap or bin may use the pallet's whole width, m, (0.1, 0.9]: heaps
+  // spread; the far boxes of a wide one may be out of reach (declined).
+  double heap_width_m = 0.80;
 
   absl::Status Validate() const;
 };
@@ -71,9 +75,10 @@ struct SimCell {
   int place_rows = 1, place_columns = 1, place_layers = 1;
   double place_spacing_x_m = 0.0, place_spacing_y_m = 0.0, place_layer_height_m = 0.0;
   // How high the held box is lifted above its grasp and lowered from onto
-  // its slot, m: its bottom clears the boxes around it by 0.1 m (a pallet's
-  // box by its height, a heap's by its longest side).
-  double lift_height_m = 0.25;
+  // its slot, m: its bottom clears the boxes around it by 0.2 m (a pallet's
+  // box by its height, a heap's by its longest side), enough for the dip of
+  // the joint move to the place pallet, which starts over the pile.
+  double lift_height_m = 0.35;
 };
 
 // Builds the cell and its load; the same options give the same cell.
