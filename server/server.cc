@@ -11,7 +11,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "server/source_factory.h"
+#include "server/sources/source_factory.h"
 
 namespace cornerpose::server {
 

@@ -8,9 +8,9 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "server/detection_pool.h"
-#include "server/perception_service.h"
-#include "server/server_options.h"
+#include "server/config/server_options.h"
+#include "server/service/detection_pool.h"
+#include "server/service/perception_service.h"
 
 namespace cornerpose::server {
 

@@ -25,10 +25,10 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
 #include "absl/strings/strip.h"
+#include "server/config/server_config.h"
+#include "server/config/server_options.h"
 #include "server/server.h"
-#include "server/server_config.h"
-#include "server/server_options.h"
-#include "server/source_spec.h"
+#include "server/sources/source_spec.h"
 
 ABSL_FLAG(std::string, config, "",
           "a configuration file (cornerpose.v1.ServerConfig, protobuf text format); flags "

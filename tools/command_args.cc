@@ -1,11 +1,22 @@
 #include "tools/command_args.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 
 namespace cornerpose::tools {
+
+bool PrintHelpIfAsked(const std::vector<std::string>& args, const char* help) {
+  for (const std::string& a : args) {
+    if (a == "--help" || a == "-h") {
+      std::fputs(help, stdout);
+      return true;
+    }
+  }
+  return false;
+}
 namespace {
 
 bool Contains(const std::vector<std::string>& list, const std::string& s) {

@@ -26,6 +26,10 @@ struct CommandArgs {
   absl::Status SetBool(const std::string& key, bool* out) const;
 };
 
+// When `args` hold --help or -h, prints `help` to stdout and returns true:
+// the command then exits 0 without parsing anything else.
+bool PrintHelpIfAsked(const std::vector<std::string>& args, const char* help);
+
 // `options` take a value; `switches` do not; `required` options must appear.
 absl::StatusOr<CommandArgs> ParseCommandArgs(const std::vector<std::string>& args,
                                              const std::vector<std::string>& options,

@@ -10,8 +10,8 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "common/box/box_models.h"
 #include "common/io/cloud_io.h"
-#include "common/perception/box_models.h"
 #include "common/perception/camera_model.h"
 #include "common/perception/detector.h"
 #include "common/viz/detection_json.h"
@@ -82,7 +82,7 @@ absl::Status Run(const CommandArgs& args) {
   }
   options.project_unorganized = !args.Has("kdtree");
   // r_s is also the gap at which a segment ends (Algorithm 1).
-  options.segments.gap_m = options.edge_points.radius_m;
+  SetEdgeRadius(options.edge_points.radius_m, &options);
 
   absl::StatusOr<PointCloud> cloud = LoadPointCloud(*get("cloud"), load);
   if (!cloud.ok()) return cloud.status();
@@ -131,12 +131,7 @@ void PrintDetection(const std::string& label, std::optional<size_t> num_points,
 }
 
 int RunDetect(const std::vector<std::string>& argv) {
-  for (const std::string& a : argv) {
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-  }
+  if (PrintHelpIfAsked(argv, kHelp)) return 0;
   absl::StatusOr<CommandArgs> args = ParseCommandArgs(
       argv,
       {"cloud", "box", "intrinsics", "json", "ply", "png", "edges", "radius", "threshold",

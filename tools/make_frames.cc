@@ -21,7 +21,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
 #include "common/io/cloud_io.h"
-#include "common/perception/box_models.h"
+#include "common/box/box_models.h"
 #include "tests/support/scene_generator.h"
 
 namespace cornerpose {

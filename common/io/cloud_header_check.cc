@@ -84,152 +84,240 @@ class LineReader {
   size_t pos_ = 0;
 };
 
-struct PcdField {
-  std::string name;
-  uint64_t size = 4;
-  char type = 'F';
-  uint64_t count = 1;
-};
+}  // namespace
+
+namespace internal {
+namespace {
+
+bool Is(absl::string_view key, absl::string_view keyword) { return absl::StartsWith(key, keyword); }
+
+// FIELDS / COLUMNS: a new field list; SIZE, TYPE and COUNT must follow again.
+void OnFieldsLine(const std::vector<absl::string_view>& st, PcdHeader* header, bool* have_size,
+                  bool* have_type) {
+  header->fields.assign(st.size() - 1, PcdField{});
+  for (size_t i = 1; i < st.size(); ++i) header->fields[i - 1].name = std::string(st[i]);
+  *have_size = *have_type = false;
+}
+
+// SIZE, TYPE or COUNT: one entry per field, in that order.
+absl::Status OnPerFieldLine(const std::vector<absl::string_view>& st, PcdHeader* header,
+                            bool* have_size, bool* have_type) {
+  const absl::string_view key = st[0];
+  const size_t n = st.size() - 1;
+  std::vector<PcdField>& fields = header->fields;
+  if (n != fields.size() || fields.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat("PCD header line '", key, "' has ", n,
+                                                   " entries for ", fields.size(), " FIELDS"));
+  }
+  for (size_t i = 0; i < n; ++i) {
+    if (Is(key, "TYPE")) {
+      if (st[i + 1].size() != 1) {
+        return absl::InvalidArgumentError("PCD TYPE entries must be F, I or U");
+      }
+      fields[i].type = st[i + 1][0];
+      continue;
+    }
+    const std::optional<uint64_t> v = ParseCount(st[i + 1]);
+    if (!v || *v == 0 || *v > 1000000) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("PCD ", key, " entry '", st[i + 1], "' is not valid"));
+    }
+    (Is(key, "SIZE") ? fields[i].size : fields[i].count) = *v;
+  }
+  if (Is(key, "SIZE")) *have_size = true;
+  if (Is(key, "TYPE")) {
+    if (!*have_size) return absl::InvalidArgumentError("PCD TYPE comes before SIZE");
+    *have_type = true;
+  }
+  if (Is(key, "COUNT") && (!*have_size || !*have_type)) {
+    return absl::InvalidArgumentError("PCD COUNT comes before SIZE or TYPE");
+  }
+  return absl::OkStatus();
+}
+
+// WIDTH, HEIGHT or POINTS: one count that fits PCL's int32.
+absl::Status OnCountLine(const std::vector<absl::string_view>& st, absl::string_view line,
+                         PcdHeader* header) {
+  const std::optional<uint64_t> v = st.size() >= 2 ? ParseCount(st[1]) : std::nullopt;
+  if (!v || *v > std::numeric_limits<int32_t>::max()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("PCD header line '", line, "' has no valid count"));
+  }
+  (Is(st[0], "WIDTH") ? header->width : Is(st[0], "HEIGHT") ? header->height : header->points) =
+      *v;
+  return absl::OkStatus();
+}
 
 }  // namespace
+
+absl::StatusOr<PcdHeader> ParsePcdHeader(absl::string_view head) {
+  PcdHeader header;
+  bool have_size = false, have_type = false, have_data = false;
+  LineReader lines(head);
+  absl::string_view line;
+  while (!have_data && lines.Next(&line)) {
+    const std::vector<absl::string_view> st = Tokens(line);
+    if (st.empty()) continue;
+    const absl::string_view key = st[0];
+    if (Is(key, "#") || Is(key, "VERSION") || Is(key, "VIEWPOINT")) continue;
+    absl::Status status;
+    if (Is(key, "FIELDS") || Is(key, "COLUMNS")) {
+      OnFieldsLine(st, &header, &have_size, &have_type);
+    } else if (Is(key, "SIZE") || Is(key, "TYPE") || Is(key, "COUNT")) {
+      status = OnPerFieldLine(st, &header, &have_size, &have_type);
+    } else if (Is(key, "WIDTH") || Is(key, "HEIGHT") || Is(key, "POINTS")) {
+      status = OnCountLine(st, line, &header);
+    } else if (Is(key, "DATA")) {
+      if (st.size() < 2) return absl::InvalidArgumentError("PCD DATA line names no format");
+      header.data = Is(st[1], "binary_compressed") ? PcdData::kBinaryCompressed
+                    : Is(st[1], "binary")          ? PcdData::kBinary
+                                                   : PcdData::kAscii;
+      header.data_offset = lines.offset();
+      have_data = true;
+    } else {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "not a PCD file: unexpected header line '", line.substr(0, 40), "'"));
+    }
+    if (!status.ok()) return status;
+  }
+  if (!have_data) return absl::InvalidArgumentError("not a PCD file: no DATA line in its header");
+  // Without them PCL lays the fields out at offset 0 with no size (found by
+  // pcd_fuzzer: its ascii reader then wrote outside the cloud).
+  if (!have_size || !have_type) {
+    return absl::InvalidArgumentError("PCD header has no SIZE and TYPE lines after its FIELDS");
+  }
+  // PCL reads on past DATA while the lines look like header lines, and obeys
+  // them (found by pcd_fuzzer: a FIELDS line after DATA crashed its reader).
+  while (lines.Next(&line)) {
+    const std::vector<absl::string_view> st = Tokens(line);
+    if (st.empty() || Is(st[0], "#") || Is(st[0], "VERSION") || Is(st[0], "VIEWPOINT")) continue;
+    for (const char* keyword :
+         {"FIELDS", "COLUMNS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "POINTS", "DATA"}) {
+      if (Is(st[0], keyword)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("PCD header line '", line.substr(0, 40), "' after DATA"));
+      }
+    }
+    break;
+  }
+  return header;
+}
+
+absl::StatusOr<PcdLayout> PcdPointLayout(const std::vector<PcdField>& fields) {
+  bool has_x = false, has_y = false, has_z = false;
+  PcdLayout layout;
+  for (const PcdField& f : fields) {
+    const bool ok_type =
+        (f.type == 'F' && (f.size == 4 || f.size == 8)) ||
+        ((f.type == 'I' || f.type == 'U') && (f.size == 1 || f.size == 2 || f.size == 4));
+    if (!ok_type) {
+      return absl::InvalidArgumentError(absl::StrCat("PCD field '", f.name,
+                                                     "' has unsupported type ",
+                                                     std::string(1, f.type), " of size ", f.size));
+    }
+    layout.point_step += f.size * f.count;
+    if (f.name != "_") layout.packed_step += f.size * f.count;
+    layout.values_per_point += f.count;
+    has_x |= f.name == "x";
+    has_y |= f.name == "y";
+    has_z |= f.name == "z";
+  }
+  if (!has_x || !has_y || !has_z) {
+    return absl::InvalidArgumentError("PCD file has no x, y and z fields");
+  }
+  return layout;
+}
+
+absl::StatusOr<uint64_t> PcdPointCount(const PcdHeader& header) {
+  if (!header.points) return absl::InvalidArgumentError("PCD header has no POINTS line");
+  const uint64_t points = *header.points;
+  // As PCL reads it: no WIDTH and HEIGHT, or no HEIGHT, is one row.
+  uint64_t w = header.width.value_or(0), h = header.height.value_or(0);
+  if (w == 0 && h == 0) w = points, h = 1;
+  if (h == 0) h = 1, w = w == 0 ? points : w;
+  if (w * h != points) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("PCD WIDTH x HEIGHT = ", w, " x ", h, " but POINTS is ", points));
+  }
+  return points;
+}
+
+absl::Status CheckPcdBodySize(PcdData data, const PcdLayout& layout, uint64_t points,
+                              uint64_t body_bytes, absl::string_view body_prefix) {
+  const uint64_t need = points * layout.point_step;
+  if (need > kMaxBodyBytes) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("PCD header announces ", need, " bytes of points, too many"));
+  }
+  switch (data) {
+    case PcdData::kAscii:
+      // Each value takes at least one character and one separator.
+      if (points * layout.values_per_point * 2 > body_bytes + 1) {
+        return absl::InvalidArgumentError(absl::StrCat("PCD ascii body of ", body_bytes,
+                                                       " bytes is too short for ", points,
+                                                       " points (truncated file?)"));
+      }
+      return absl::OkStatus();
+    case PcdData::kBinary:
+      if (need > body_bytes) {
+        return absl::InvalidArgumentError(absl::StrCat("PCD binary body holds ", body_bytes,
+                                                       " bytes, ", need,
+                                                       " expected (truncated file?)"));
+      }
+      return absl::OkStatus();
+    case PcdData::kBinaryCompressed:
+      break;
+  }
+  if (points == 0) return absl::OkStatus();
+  if (body_bytes < 8 || body_prefix.size() < 8) {
+    return absl::InvalidArgumentError("PCD binary_compressed body is truncated");
+  }
+  uint32_t compressed = 0, uncompressed = 0;
+  std::memcpy(&compressed, body_prefix.data(), 4);
+  std::memcpy(&uncompressed, body_prefix.data() + 4, 4);
+  if (uint64_t{compressed} + 8 > body_bytes) {
+    return absl::InvalidArgumentError(absl::StrCat("PCD compressed block of ", compressed,
+                                                   " bytes but only ", body_bytes - 8,
+                                                   " in the file (truncated file?)"));
+  }
+  if (uncompressed != points * layout.packed_step ||
+      uncompressed > uint64_t{compressed} * kMaxLzfRatio + 1024) {
+    return absl::InvalidArgumentError(absl::StrCat("PCD compressed block expands to ",
+                                                   uncompressed, " bytes, which does not match ",
+                                                   points, " points"));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace internal
 
 absl::Status CheckPcdHeader(const std::string& path) {
   std::string head;
   uint64_t file_size = 0;
   if (absl::Status s = ReadHead(path, &head, &file_size); !s.ok()) return s;
   if (file_size == 0) return Invalid(path, "empty file, not a PCD point cloud");
+  const auto with_path = [&](const absl::Status& s) { return Invalid(path, s.message()); };
 
-  std::vector<PcdField> fields;
-  bool have_size = false, have_type = false;
-  std::optional<uint64_t> width, height, points;
-  std::string data_kind;
-  size_t data_idx = 0;
-  LineReader lines(head);
-  absl::string_view line;
-  while (lines.Next(&line)) {
-    const std::vector<absl::string_view> st = Tokens(line);
-    if (st.empty()) continue;
-    const absl::string_view key = st[0];
-    if (absl::StartsWith(key, "#") || absl::StartsWith(key, "VERSION") ||
-        absl::StartsWith(key, "VIEWPOINT"))
-      continue;
-    const size_t n = st.size() - 1;
-    if (absl::StartsWith(key, "FIELDS") || absl::StartsWith(key, "COLUMNS")) {
-      fields.assign(n, PcdField{});
-      for (size_t i = 0; i < n; ++i) fields[i].name = std::string(st[i + 1]);
-      have_size = have_type = false;
-    } else if (absl::StartsWith(key, "SIZE") || absl::StartsWith(key, "TYPE") ||
-               absl::StartsWith(key, "COUNT")) {
-      if (n != fields.size() || fields.empty()) {
-        return Invalid(path, absl::StrCat("PCD header line '", key, "' has ", n, " entries for ",
-                                          fields.size(), " FIELDS"));
-      }
-      for (size_t i = 0; i < n; ++i) {
-        if (absl::StartsWith(key, "TYPE")) {
-          if (st[i + 1].size() != 1) return Invalid(path, "PCD TYPE entries must be F, I or U");
-          fields[i].type = st[i + 1][0];
-          continue;
-        }
-        const std::optional<uint64_t> v = ParseCount(st[i + 1]);
-        if (!v || *v == 0 || *v > 1000000) {
-          return Invalid(path, absl::StrCat("PCD ", key, " entry '", st[i + 1], "' is not valid"));
-        }
-        (absl::StartsWith(key, "SIZE") ? fields[i].size : fields[i].count) = *v;
-      }
-      if (absl::StartsWith(key, "SIZE")) have_size = true;
-      if (absl::StartsWith(key, "TYPE")) {
-        if (!have_size) return Invalid(path, "PCD TYPE comes before SIZE");
-        have_type = true;
-      }
-      if (absl::StartsWith(key, "COUNT") && (!have_size || !have_type)) {
-        return Invalid(path, "PCD COUNT comes before SIZE or TYPE");
-      }
-    } else if (absl::StartsWith(key, "WIDTH") || absl::StartsWith(key, "HEIGHT") ||
-               absl::StartsWith(key, "POINTS")) {
-      const std::optional<uint64_t> v = n >= 1 ? ParseCount(st[1]) : std::nullopt;
-      if (!v || *v > std::numeric_limits<int32_t>::max()) {
-        return Invalid(path, absl::StrCat("PCD header line '", line, "' has no valid count"));
-      }
-      (absl::StartsWith(key, "WIDTH")    ? width
-       : absl::StartsWith(key, "HEIGHT") ? height
-                                         : points) = *v;
-    } else if (absl::StartsWith(key, "DATA")) {
-      if (n < 1) return Invalid(path, "PCD DATA line names no format");
-      data_kind = absl::StartsWith(st[1], "binary_compressed") ? "binary_compressed"
-                  : absl::StartsWith(st[1], "binary")          ? "binary"
-                                                               : "ascii";
-      data_idx = lines.offset();
-      break;
-    } else {
-      return Invalid(
-          path, absl::StrCat("not a PCD file: unexpected header line '", line.substr(0, 40), "'"));
-    }
-  }
-  if (data_kind.empty()) return Invalid(path, "not a PCD file: no DATA line in its header");
+  const absl::StatusOr<internal::PcdHeader> header = internal::ParsePcdHeader(head);
+  if (!header.ok()) return with_path(header.status());
+  const absl::StatusOr<internal::PcdLayout> layout = internal::PcdPointLayout(header->fields);
+  if (!layout.ok()) return with_path(layout.status());
+  const absl::StatusOr<uint64_t> points = internal::PcdPointCount(*header);
+  if (!points.ok()) return with_path(points.status());
 
-  bool has_x = false, has_y = false, has_z = false;
-  uint64_t point_step = 0, packed_step = 0, values_per_point = 0;
-  for (const PcdField& f : fields) {
-    const bool ok_type =
-        (f.type == 'F' && (f.size == 4 || f.size == 8)) ||
-        ((f.type == 'I' || f.type == 'U') && (f.size == 1 || f.size == 2 || f.size == 4));
-    if (!ok_type) {
-      return Invalid(path, absl::StrCat("PCD field '", f.name, "' has unsupported type ",
-                                        std::string(1, f.type), " of size ", f.size));
-    }
-    point_step += f.size * f.count;
-    if (f.name != "_") packed_step += f.size * f.count;
-    values_per_point += f.count;
-    has_x |= f.name == "x";
-    has_y |= f.name == "y";
-    has_z |= f.name == "z";
-  }
-  if (!has_x || !has_y || !has_z) return Invalid(path, "PCD file has no x, y and z fields");
-  if (!points) return Invalid(path, "PCD header has no POINTS line");
-  uint64_t w = width.value_or(0), h = height.value_or(0);
-  if (w == 0 && h == 0) w = *points, h = 1;
-  if (h == 0) h = 1, w = w == 0 ? *points : w;
-  if (w * h != *points) {
-    return Invalid(path,
-                   absl::StrCat("PCD WIDTH x HEIGHT = ", w, " x ", h, " but POINTS is ", *points));
-  }
-
-  const uint64_t body = file_size - data_idx;
-  const uint64_t need = *points * point_step;
-  if (need > kMaxBodyBytes) {
-    return Invalid(path, absl::StrCat("PCD header announces ", need, " bytes of points, too many"));
-  }
-  if (data_kind == "ascii") {
-    // Each value takes at least one character and one separator.
-    if (*points * values_per_point * 2 > body + 1) {
-      return Invalid(path, absl::StrCat("PCD ascii body of ", body, " bytes is too short for ",
-                                        *points, " points (truncated file?)"));
-    }
-  } else if (data_kind == "binary") {
-    if (need > body) {
-      return Invalid(path, absl::StrCat("PCD binary body holds ", body, " bytes, ", need,
-                                        " expected (truncated file?)"));
-    }
-  } else {
-    if (*points == 0) return absl::OkStatus();
-    if (body < 8) return Invalid(path, "PCD binary_compressed body is truncated");
-    char sizes[8] = {};
+  // The compressed block's two sizes open the body; read them from the file
+  // when the header filled all that ReadHead() took.
+  std::string body_prefix = head.substr(std::min(head.size(), header->data_offset), 8);
+  if (body_prefix.size() < 8 && header->data_offset + 8 <= file_size) {
     std::ifstream in(path, std::ios::binary);
-    in.seekg(static_cast<std::streamoff>(data_idx));
-    if (!in.read(sizes, sizeof(sizes)))
-      return Invalid(path, "cannot read the PCD compressed sizes");
-    uint32_t compressed = 0, uncompressed = 0;
-    std::memcpy(&compressed, sizes, 4);
-    std::memcpy(&uncompressed, sizes + 4, 4);
-    if (uint64_t{compressed} + 8 > body) {
-      return Invalid(path, absl::StrCat("PCD compressed block of ", compressed, " bytes but only ",
-                                        body - 8, " in the file (truncated file?)"));
-    }
-    if (uncompressed != *points * packed_step ||
-        uncompressed > uint64_t{compressed} * kMaxLzfRatio + 1024) {
-      return Invalid(path, absl::StrCat("PCD compressed block expands to ", uncompressed,
-                                        " bytes, which does not match ", *points, " points"));
-    }
+    body_prefix.resize(8);
+    in.seekg(static_cast<std::streamoff>(header->data_offset));
+    if (!in.read(body_prefix.data(), 8)) return Invalid(path, "cannot read the PCD body");
+  }
+  if (absl::Status s = internal::CheckPcdBodySize(header->data, *layout, *points,
+                                                  file_size - header->data_offset, body_prefix);
+      !s.ok()) {
+    return with_path(s);
   }
   return absl::OkStatus();
 }

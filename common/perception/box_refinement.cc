@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/validation/range_check.h"
 
 namespace cornerpose {
 namespace {
@@ -339,13 +340,22 @@ int TileCount(double extent, double tile, double tolerance, const RefinementOpti
 }  // namespace
 
 absl::Status RefinementOptions::Validate() const {
-  if (!(plane_tolerance_m > 0.0 && plane_tolerance_m <= 0.2) ||
-      !(side_band_m > 0.005 && side_band_m <= 0.2) ||
-      !(free_side_ratio >= 0.0 && free_side_ratio <= 1.0) || iterations < 0 || iterations > 20 ||
-      !(max_shift_m > 0.0) || !(max_turn_deg > 0.0)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "refinement options out of range: plane_tolerance_m=", plane_tolerance_m, " side_band_m=",
-        side_band_m, " free_side_ratio=", free_side_ratio, " iterations=", iterations));
+  for (absl::Status s : {
+           CheckPositive("refinement.plane_tolerance_m", plane_tolerance_m, 0.2),
+           CheckRange("refinement.side_band_m", side_band_m, 0.005, 0.2),
+           CheckRange("refinement.free_side_ratio", free_side_ratio, 0.0, 1.0),
+           CheckRange("refinement.min_seam_depth_m", min_seam_depth_m, 0.0, 0.1),
+           CheckRange("refinement.max_seam_density", max_seam_density, 0.0, 1.0),
+           CheckRange("refinement.weak_seam_density", weak_seam_density, 0.0, 1.0),
+           CheckRange("refinement.seam_search_m", seam_search_m, 0.0, 0.2),
+           CheckRange("refinement.tile_gap_m", tile_gap_m, 0.0, 0.2),
+           CheckRange("refinement.tile_tolerance_m", tile_tolerance_m, 0.0, 0.2),
+           CheckRange("refinement.max_tile_march_m", max_tile_march_m, 0.0, 100.0),
+           CheckRange("refinement.iterations", iterations, 0, 20),
+           CheckPositive("refinement.max_shift_m", max_shift_m),
+           CheckPositive("refinement.max_turn_deg", max_turn_deg),
+       }) {
+    if (!s.ok()) return s;
   }
   return absl::OkStatus();
 }

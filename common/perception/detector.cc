@@ -11,6 +11,7 @@
 #include "common/perception/internal/box_overlap.h"
 #include "common/perception/internal/hypothesis_judge.h"
 #include "common/perception/neighbour_hypotheses.h"
+#include "common/validation/range_check.h"
 
 namespace cornerpose {
 namespace {
@@ -22,12 +23,16 @@ double MsSince(Clock::time_point t0) {
 
 // Points with a NaN, an infinity or a coordinate beyond any depth camera's
 // range in any axis become NaN points (no return), so one bad value cannot
-// poison the intrinsics fit or a neighbourhood. Copies only when needed.
+// poison the intrinsics fit or a neighbourhood; in a camera frame (organized)
+// so do depths nearer than any depth camera measures (the pixel radius
+// r fx / z grows without bound as z -> 0). Copies only when needed.
 const PointCloud& SanitizeCloud(const PointCloud& cloud, PointCloud* storage) {
   constexpr float kMaxCoordinate = 100.0f;  // metres
-  auto bad = [](const Eigen::Vector3f& p) {
+  constexpr float kMinCameraDepthM = 0.01f;  // depth cameras' minimum range is centimetres
+  const float min_depth = cloud.organized() ? kMinCameraDepthM : -kMaxCoordinate;
+  auto bad = [min_depth](const Eigen::Vector3f& p) {
     return !(std::abs(p.x()) <= kMaxCoordinate && std::abs(p.y()) <= kMaxCoordinate &&
-             std::abs(p.z()) <= kMaxCoordinate) &&
+             p.z() >= min_depth && p.z() <= kMaxCoordinate) &&
            !(std::isnan(p.x()) && std::isnan(p.y()) && std::isnan(p.z()));
   };
   if (std::none_of(cloud.xyz.begin(), cloud.xyz.end(), bad)) return cloud;
@@ -42,14 +47,19 @@ const PointCloud& SanitizeCloud(const PointCloud& cloud, PointCloud* storage) {
 }  // namespace
 
 absl::Status AcceptanceOptions::Validate() const {
-  for (double v : {min_support, min_grasp_support, max_grasp_occluded, max_see_through}) {
-    if (!(v >= 0.0 && v <= 1.0)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("acceptance fraction ", v, " is outside [0, 1]"));
-    }
-  }
-  if (min_grasp_pixels < 1 || !(extent_tolerance_m > 0.0) || !(overlap_margin_m >= 0.0)) {
-    return absl::InvalidArgumentError("acceptance limits out of range");
+  for (absl::Status s : {
+           CheckRange("acceptance.min_support", min_support, 0.0, 1.0),
+           CheckRange("acceptance.min_grasp_support", min_grasp_support, 0.0, 1.0),
+           CheckRange("acceptance.max_grasp_occluded", max_grasp_occluded, 0.0, 1.0),
+           CheckRange("acceptance.max_occluded", max_occluded, 0.0, 1.0),
+           CheckRange("acceptance.max_see_through", max_see_through, 0.0, 1.0),
+           CheckRange("acceptance.min_grasp_pixels", min_grasp_pixels, 1, 1'000'000),
+           CheckPositive("acceptance.extent_tolerance_m", extent_tolerance_m, 1.0),
+           CheckRange("acceptance.max_grasp_view_angle_deg", max_grasp_view_angle_deg, 0.0, 90.0),
+           CheckRange("acceptance.border_margin_px", border_margin_px, 0.0, 1000.0),
+           CheckRange("acceptance.overlap_margin_m", overlap_margin_m, 0.0, 1.0),
+       }) {
+    if (!s.ok()) return s;
   }
   return absl::OkStatus();
 }
@@ -70,6 +80,15 @@ absl::Status DetectorOptions::Validate() const {
   }
   if (max_points < 1) return absl::InvalidArgumentError("max_points must be positive");
   return absl::OkStatus();
+}
+
+void SetEdgeRadius(double radius_m, DetectorOptions* options) {
+  options->edge_points.radius_m = radius_m;
+  options->segments.gap_m = radius_m;
+}
+
+void UseFrameCamera(const std::optional<CameraIntrinsics>& frame_camera, DetectorOptions* options) {
+  if (frame_camera) options->camera = frame_camera;
 }
 
 absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOptions& options_in) {
@@ -94,6 +113,10 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
       det.timings.total_ms = MsSince(t_start);
       return det;
     }
+    if (absl::Status s = k->Validate(); !s.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("the organized cloud's points imply implausible ", s.message()));
+    }
     camera = *k;
   }
   // A single-view unorganized cloud is laid back onto the camera's pixel
@@ -104,6 +127,8 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   bool project = !cloud.organized() && options.project_unorganized;
   if (project) {
     projected = OrganizeByProjection(cloud, camera);
+    PointCloud in_range;  // the projected frame gets a camera's depth range
+    if (&SanitizeCloud(projected, &in_range) != &projected) projected = std::move(in_range);
     const auto valid = [](const std::vector<Eigen::Vector3f>& xyz) {
       return std::count_if(xyz.begin(), xyz.end(), PointCloud::IsValid);
     };

@@ -17,6 +17,11 @@
 
 namespace cornerpose {
 
+// Frames above this many points are refused: by the detector
+// (DetectorOptions::max_points) and by the wire library before it unpacks
+// one. Count.
+inline constexpr int kMaxPoints = 20'000'000;
+
 struct AcceptanceOptions {
   // Share of the box's unoccluded rendered pixels the depth confirms. Unitless.
   double min_support = 0.6;
@@ -72,10 +77,19 @@ struct DetectorOptions {
   // Worker threads (edge points). Count.
   int num_threads = 2;
   // Frames above this many points are refused. Count.
-  int max_points = 20'000'000;
+  int max_points = kMaxPoints;
 
   absl::Status Validate() const;
 };
+
+// Sets the edge radius r_s and the gap at which a segment ends, which
+// Algorithm 1 ties to it: every front end sets r_s through this.
+void SetEdgeRadius(double radius_m, DetectorOptions* options);
+
+// The camera of a frame whose source knows it (a depth image, a device)
+// replaces the one in *options (a request's intrinsics, the default); a
+// frame without one leaves *options unchanged.
+void UseFrameCamera(const std::optional<CameraIntrinsics>& frame_camera, DetectorOptions* options);
 
 // Runs the detector on one cloud. Empty, all-NaN and box-free clouds give an
 // empty Detection; malformed clouds and bad options give INVALID_ARGUMENT.

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <numbers>
 #include <thread>
+#include <unordered_set>
 
 #include "absl/strings/str_cat.h"
 #include "common/perception/internal/parallel.h"
@@ -161,7 +162,9 @@ class OrganizedScorer {
     const float reach2 = 2.25f * radius2_;  // 1.5 r_s: room for p's own noise
     // CutByBorder() has kept the whole disc inside the image.
     const Eigen::Vector3f* base = &cloud_.xyz[static_cast<size_t>(v) * cloud_.width + u];
-    const int bucket = std::min(kMaxBucket, static_cast<int>(radius_px * 4.0f + 0.5f));
+    // Clamped before the cast: r fx / z is unbounded for a point near z = 0.
+    const float quarter_px = radius_px * 4.0f + 0.5f;
+    const int bucket = quarter_px < kMaxBucket ? static_cast<int>(quarter_px) : kMaxBucket;
     for (const int off : offsets_[bucket]) {
       const Eigen::Vector3f& q = base[off];
       if (!(q.z() == q.z())) continue;  // NaN: no return
@@ -191,6 +194,8 @@ class OrganizedScorer {
   }
 
   bool OnOccludedSide(int u, int v, const Eigen::Vector3f& p, float radius_px) const {
+    // Past the image's size every offset leaves it; keeps the rounding in int.
+    radius_px = std::min(radius_px, static_cast<float>(cloud_.width + cloud_.height));
     const float nearer = p.z() - static_cast<float>(options_.occluded_side_jump_m);
     for (const Eigen::Vector2f& o : pattern_) {
       const Eigen::Vector3f* q = At(u + static_cast<int>(std::lround(o.x() * radius_px)),
@@ -249,28 +254,61 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
   return Merge(cloud, chunks);
 }
 
-EdgePoints DetectUnorganized(const PointCloud& cloud, const EdgePointOptions& options) {
-  auto pcl_cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+// Key of the voxel (edge `voxel` metres) holding p; 21 bits per axis, clamped
+// (beyond +-2^20 voxels, far outside any sensor's range, cells merge).
+uint64_t VoxelKey(const Eigen::Vector3f& p, double voxel) {
+  constexpr double kHalf = 1 << 20;
+  uint64_t key = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double cell = std::clamp(std::floor(p[axis] / voxel), -kHalf, kHalf - 1) + kHalf;
+    key = (key << 21) | static_cast<uint64_t>(cell);
+  }
+  return key;
+}
+
+absl::StatusOr<EdgePoints> DetectUnorganized(const PointCloud& cloud,
+                                             const EdgePointOptions& options) {
+  // Every finite point is scored, but the k-d tree holds only the first point
+  // of each voxel of r_s / kKdVoxelsPerRadius: a ball of radius r_s then
+  // holds at most ~(4/3) pi 8^3 = 2145 tree points however the input piles
+  // up (a radius search over 200 000 identical points returned all of them,
+  // for every one of them), and a surface ~200.
+  constexpr double kKdVoxelsPerRadius = 8.0;
+  std::vector<Eigen::Vector3f> queries;
   std::vector<int> original_index;
-  pcl_cloud->reserve(cloud.size());
   for (size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3f& p = cloud.xyz[i];
     if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) continue;
-    pcl_cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    queries.push_back(p);
     original_index.push_back(static_cast<int>(i));
   }
+  if (queries.size() > kMaxKdTreePoints) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("unorganized cloud has ", queries.size(),
+                     " finite points; the k-d tree path scores at most ", kMaxKdTreePoints,
+                     " (send an organized frame or a single camera's cloud)"));
+  }
+  auto pcl_cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  std::unordered_set<uint64_t> taken;
+  for (const Eigen::Vector3f& p : queries) {
+    if (taken.insert(VoxelKey(p, options.radius_m / kKdVoxelsPerRadius)).second) {
+      pcl_cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    }
+  }
   std::vector<Chunk> chunks(options.num_threads);
+  std::vector<int64_t> examined(options.num_threads, 0);
   if (pcl_cloud->empty()) return Merge(cloud, chunks);
   pcl::KdTreeFLANN<pcl::PointXYZ> tree;
   tree.setInputCloud(pcl_cloud);
-  const int n = static_cast<int>(pcl_cloud->size());
+  const int n = static_cast<int>(queries.size());
   internal::ParallelForRanges(n, options.num_threads, [&](int t, int begin, int end) {
     pcl::Indices found;
     std::vector<float> dist2, dz;
     const float r2 = static_cast<float>(options.radius_m * options.radius_m);
     for (int i = begin; i < end; ++i) {
-      const pcl::PointXYZ& q = (*pcl_cloud)[i];
+      const pcl::PointXYZ q(queries[i].x(), queries[i].y(), queries[i].z());
       tree.radiusSearch(q, options.radius_m, found, dist2);
+      examined[t] += static_cast<int64_t>(found.size());
       Eigen::Vector3f p = q.getVector3fMap();
       if (options.denoise && found.size() >= 3 && p.z() > 0.0f) {
         // As on organized frames: score from the neighbours' median depth,
@@ -293,7 +331,10 @@ EdgePoints DetectUnorganized(const PointCloud& cloud, const EdgePointOptions& op
       chunks[t].scores.push_back(score);
     }
   });
-  return Merge(cloud, chunks);
+  EdgePoints out = Merge(cloud, chunks);
+  out.kdtree_points = pcl_cloud->size();
+  for (int64_t e : examined) out.neighbours_examined += e;
+  return out;
 }
 
 }  // namespace

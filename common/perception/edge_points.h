@@ -5,6 +5,8 @@
 // (0.64), a 90 degree crease ~0.45; p is an edge point when s(p) > t_h.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -51,7 +53,15 @@ struct EdgePoints {
   std::vector<Eigen::Vector3f> points;  // camera frame, metres
   std::vector<int> indices;             // index of each edge point in the input cloud
   std::vector<float> scores;            // s(p) of each edge point
+  // Unorganized clouds (the k-d tree path) only, a measure of the work done:
+  // points in the k-d tree (one per voxel of r_s / 8) and neighbours the
+  // radius searches returned, summed over all points.
+  size_t kdtree_points = 0;
+  int64_t neighbours_examined = 0;
 };
+
+// The most finite points the k-d tree path scores; more is INVALID_ARGUMENT.
+inline constexpr size_t kMaxKdTreePoints = 1'000'000;
 
 // Scores one point against an explicit neighbour list (the paper's formula).
 // Neighbours equal to p are ignored. Returns 0 with no usable neighbour.
@@ -60,7 +70,9 @@ float EdgeScore(const Eigen::Vector3f& p, const std::vector<Eigen::Vector3f>& ne
 // Finds the edge points of a cloud. Organized clouds (height > 1) use the
 // pixel grid for neighbour search and need the camera's focal length (pixels),
 // which EstimateIntrinsics() can recover from the cloud itself; unorganized
-// clouds use a k-d tree over all neighbours within r_s, as in the paper.
+// clouds use a k-d tree over the neighbours within r_s, as in the paper, but
+// at most one per voxel of r_s / 8, so that no pile of points makes the
+// search quadratic.
 absl::StatusOr<EdgePoints> DetectEdgePoints(const PointCloud& cloud,
                                             const EdgePointOptions& options,
                                             double focal_px = 525.0);

@@ -1,5 +1,7 @@
 #include "common/perception/types.h"
 
+#include <utility>
+
 #include "absl/strings/str_cat.h"
 
 namespace cornerpose {
@@ -24,47 +26,28 @@ absl::Status PointCloud::Validate() const {
   return absl::OkStatus();
 }
 
+// Plausible ranges: sides (0, 16384]; fx, fy [1, 1e5] px; cx, cy [-1e5, 1e5]
+// px (a crop may put the principal point outside its own image).
 absl::Status CameraIntrinsics::Validate() const {
   if (width <= 0 || height <= 0 || width > 16384 || height > 16384) {
     return absl::InvalidArgumentError(
         absl::StrCat("intrinsics image size ", width, " x ", height, " is out of (0, 16384]"));
   }
-  if (!(fx > 0.0) || !(fy > 0.0) || !std::isfinite(fx) || !std::isfinite(fy)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("intrinsics focal lengths fx=", fx, " fy=", fy, " must be positive"));
-  }
-  if (!std::isfinite(cx) || !std::isfinite(cy)) {
-    return absl::InvalidArgumentError("intrinsics principal point is not finite");
-  }
-  return absl::OkStatus();
-}
-
-absl::Status BoxDims::Validate() const {
-  const double sides[3] = {l, b, h};
-  const char* names[3] = {"l", "b", "h"};
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(sides[i]) || sides[i] <= 0.0) {
+  constexpr double kMaxPixels = 1e5;
+  for (const auto& [name, value] : {std::pair{"fx", fx}, std::pair{"fy", fy}}) {
+    if (!(value >= 1.0 && value <= kMaxPixels)) {
       return absl::InvalidArgumentError(
-          absl::StrCat("box size ", names[i], "=", sides[i], " m must be positive"));
+          absl::StrCat("intrinsics ", name, "=", value, " px is outside [1, ", kMaxPixels, "]"));
     }
-    if (sides[i] > 10.0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("box size ", names[i], "=", sides[i], " m is above the 10 m limit"));
+  }
+  for (const auto& [name, value] : {std::pair{"cx", cx}, std::pair{"cy", cy}}) {
+    if (!(std::abs(value) <= kMaxPixels)) {
+      return absl::InvalidArgumentError(absl::StrCat("intrinsics ", name, "=", value,
+                                                     " px is outside [-", kMaxPixels, ", ",
+                                                     kMaxPixels, "]"));
     }
   }
   return absl::OkStatus();
-}
-
-const char* BoxFaceName(BoxFace face) {
-  static constexpr const char* kNames[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
-  return kNames[static_cast<int>(face)];
-}
-
-Eigen::Vector3d BoxFaceNormal(BoxFace face) {
-  const int i = static_cast<int>(face);
-  Eigen::Vector3d n = Eigen::Vector3d::Zero();
-  n[i / 2] = (i % 2 == 0) ? 1.0 : -1.0;
-  return n;
 }
 
 }  // namespace cornerpose

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "common/box/box_types.h"  // BoxDims, BoxFace, DetectedBox: shared beyond the core
 
 namespace cornerpose {
 
@@ -53,25 +54,6 @@ struct CameraIntrinsics {
   absl::Status Validate() const;
 };
 
-// The known size of the boxes to find, metres: l along the box x axis,
-// b along y, h along z.
-struct BoxDims {
-  double l = 0.0;
-  double b = 0.0;
-  double h = 0.0;
-
-  double operator[](int axis) const { return axis == 0 ? l : axis == 1 ? b : h; }
-  Eigen::Vector3d vec() const { return {l, b, h}; }
-  // INVALID_ARGUMENT when a side is not finite, <= 0, or above 10 m.
-  absl::Status Validate() const;
-};
-
-// One of the six faces of a box: +x is the face at x = +l/2, and so on.
-enum class BoxFace : uint8_t { kPlusX = 0, kMinusX, kPlusY, kMinusY, kPlusZ, kMinusZ };
-const char* BoxFaceName(BoxFace face);  // "+x", "-x", ...
-// Outward unit normal of a face in the box frame.
-Eigen::Vector3d BoxFaceNormal(BoxFace face);
-
 // An edge segment found in the edge points: two extremities and its support.
 struct EdgeSegment {
   Eigen::Vector3f end1 = Eigen::Vector3f::Zero();        // camera frame, m
@@ -90,19 +72,6 @@ struct Corner {
   int segment_b = -1;
   bool a_at_end1 = true;  // which extremity of segment_a meets
   bool b_at_end1 = true;
-};
-
-// A box found in the cloud.
-struct DetectedBox {
-  Eigen::Isometry3d camera_T_box = Eigen::Isometry3d::Identity();
-  // Confidence in [0, 1]: the share of the box's expected visible surface
-  // that the cloud confirms, lowered by contradicting evidence.
-  double score = 0.0;
-  BoxFace grasp_face = BoxFace::kPlusZ;  // the face that looks at the camera
-  Eigen::Vector3d grasp_centre_camera = Eigen::Vector3d::Zero();  // its centre, m
-  Eigen::Vector3d grasp_normal_camera = Eigen::Vector3d::Zero();  // its outward normal
-  std::vector<int> segments;  // edge segments that support the box
-  int num_corners = 0;        // corners used for its pose
 };
 
 // Wall-clock time of each stage, milliseconds.

@@ -216,6 +216,12 @@ absl::StatusOr<RobotState> ParseRobotState(absl::string_view body) {
     const uint8_t type = *r.U8();
     const absl::string_view sub = *r.Bytes(static_cast<size_t>(*length) - kHeaderSize);
     const std::string where = absl::StrCat("ROBOT_STATE sub-package type ", type);
+    // A second one of a decoded type would overwrite the first (found by
+    // fuzz/ur_primary_fuzzer: the package no longer re-encoded to its bytes).
+    const bool decoded = type == 0 || type == 1 || type == 3 || type == 4;
+    if (decoded && std::find(state.order.begin(), state.order.end(), type) != state.order.end()) {
+      return absl::InvalidArgumentError(absl::StrCat(where, " appears twice"));
+    }
     state.order.push_back(type);
     switch (static_cast<RobotStateType>(type)) {
       case RobotStateType::kRobotModeData: {

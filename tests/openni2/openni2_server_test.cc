@@ -14,7 +14,7 @@
 
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "server/server.h"
-#include "server/source_spec.h"
+#include "server/sources/source_spec.h"
 #include "tests/openni2/openni2_test_support.h"
 #include "tests/server/source_server_fixture.h"
 

@@ -1,7 +1,7 @@
 // OpenNi2Source through OpenNI2 itself: the live-device path on the virtual
 // camera, the playback path on an .oni recorded from it, and the failures
 // (missing device, unreadable recording) that must be reported and retried.
-#include "server/openni2_source.h"
+#include "server/sources/openni2_source.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

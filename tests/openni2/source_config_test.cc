@@ -8,8 +8,8 @@
 #include <fstream>
 #include <string>
 
-#include "server/server_config.h"
-#include "server/source_spec.h"
+#include "server/config/server_config.h"
+#include "server/sources/source_spec.h"
 
 namespace cornerpose::server {
 namespace {

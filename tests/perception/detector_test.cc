@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "common/perception/box_models.h"
+#include "common/box/box_models.h"
 #include "common/perception/box_pose.h"
 #include "common/perception/pose_error.h"
 #include "tests/support/scene_generator.h"

@@ -12,14 +12,14 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "robot_client/grasp_geometry.h"
-#include "robot_client/pick_plan.h"
-#include "robot_client/pick_selection.h"
-#include "robot_client/place_pattern.h"
-#include "robot_client/robot_config.h"
-#include "robot_client/straight_move.h"
+#include "robot_client/config/robot_config.h"
+#include "robot_client/planning/grasp_geometry.h"
+#include "robot_client/planning/pick_plan.h"
+#include "robot_client/planning/pick_selection.h"
+#include "robot_client/planning/place_pattern.h"
+#include "robot_client/planning/straight_move.h"
+#include "robot_client/planning/urscript_program.h"
 #include "robot_client/ur/kinematics.h"
-#include "robot_client/urscript_program.h"
 #include "tests/robot_client/test_config.h"
 #include "tests/robot_client/test_poses.h"
 

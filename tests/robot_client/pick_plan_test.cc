@@ -3,7 +3,7 @@
 // rotation, the box's bottom on the slot), with workspace and reachability
 // refusals naming the waypoint; CheckStraightMove, and PlanPick skipping
 // orientations whose straight moves pass a singularity.
-#include "robot_client/pick_plan.h"
+#include "robot_client/planning/pick_plan.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -11,8 +11,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "robot_client/grasp_geometry.h"
-#include "robot_client/straight_move.h"
+#include "robot_client/planning/grasp_geometry.h"
+#include "robot_client/planning/straight_move.h"
 #include "robot_client/ur/kinematics.h"
 #include "robot_client/ur/pose.h"
 #include "tests/robot_client/test_poses.h"

@@ -1,6 +1,6 @@
 // SelectPick: rejections with reasons (score, tilt, workspace,
 // reachability), topmost first with a height tolerance, then score.
-#include "robot_client/pick_selection.h"
+#include "robot_client/planning/pick_selection.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // SlotPose: row-major within a layer, then layers up, in the origin's frame;
 // RESOURCE_EXHAUSTED past the end.
-#include "robot_client/place_pattern.h"
+#include "robot_client/planning/place_pattern.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // LoadRobotClientConfig: the shipped file loads with the values it states;
 // each kind of bad file fails with INVALID_ARGUMENT naming the file and what
 // is wrong; a missing file is NOT_FOUND.
-#include "robot_client/robot_config.h"
+#include "robot_client/config/robot_config.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "robot_client/planning/urscript_program.h"
 #include "robot_client/ur/pose.h"
-#include "robot_client/urscript_program.h"
 #include "tests/robot_client/test_poses.h"
 #include "tests/support/ur_emulator/urscript.h"
 

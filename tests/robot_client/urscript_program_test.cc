@@ -1,7 +1,7 @@
 // RenderPickProgram: the exact text for a fixed plan, the structure of every
 // rendered program, pose literals that parse back to the planned rotations
 // (including rotations near 180 degrees), and bad names refused.
-#include "robot_client/urscript_program.h"
+#include "robot_client/planning/urscript_program.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,7 +1,10 @@
-#include "server/detect_request.h"
+#include "server/service/detect_request.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
 
 namespace cornerpose::server {
 namespace {
@@ -122,6 +125,48 @@ TEST(CloudFromRequestTest, DepthImageUsesRequestIntrinsics) {
   ASSERT_TRUE(cloud.ok()) << cloud.status();
   ASSERT_EQ(cloud->size(), 1u);
   EXPECT_FLOAT_EQ(cloud->xyz[0].z(), 1.0f);
+}
+
+TEST(DetectorOptionsFromRequestTest, StreamRequestsResolveTheSameWay) {
+  const BoxModels models = {{"crate", {0.5, 0.4, 0.3}}};
+  v1::StreamDetectionsRequest request;
+  request.set_source("cell");
+  request.set_box_model("crate");
+  request.mutable_overrides()->set_edge_radius_m(0.025);
+  absl::StatusOr<DetectorOptions> options = DetectorOptionsFromRequest(request, {}, models);
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(options->box.l, 0.5);
+  // r_s and the segment gap stay tied.
+  EXPECT_EQ(options->edge_points.radius_m, 0.025);
+  EXPECT_EQ(options->segments.gap_m, 0.025);
+
+  request.clear_box_model();
+  absl::Status s = DetectorOptionsFromRequest(request, {}).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("request has no box size"));
+}
+
+TEST(CloudFromRequestTest, ColourImageBecomesTheCloudsColour) {
+  v1::DetectRequest request;
+  v1::PointCloud* cloud = request.mutable_cloud();
+  const float xyz[6] = {0, 0, 1, 0.1f, 0, 1};
+  cloud->set_xyz(std::string(reinterpret_cast<const char*>(xyz), sizeof(xyz)));
+  cloud->set_width(2);
+  cloud->set_height(1);
+  v1::ColorImage* color = request.mutable_color();
+  color->set_width(2);
+  color->set_height(1);
+  color->set_encoding(v1::COLOR_ENCODING_RGB8);
+  color->set_data(std::string("\xff\x00\x00\x00\x00\xff", 6));
+  absl::StatusOr<PointCloud> with_color = CloudFromRequest(request);
+  ASSERT_TRUE(with_color.ok()) << with_color.status();
+  EXPECT_EQ(with_color->rgb, (std::vector<uint32_t>{0x00ff0000u, 0x000000ffu}));
+
+  // Colour twice (cloud.rgb and color) is refused.
+  cloud->set_rgb(std::string(6, '\0'));
+  absl::Status s = CloudFromRequest(request).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("cloud.rgb or color, not both"));
 }
 
 }  // namespace

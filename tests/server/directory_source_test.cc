@@ -1,6 +1,6 @@
 // DirectorySource over temporary directories of PCDs and depth PNGs, and the
 // --source flag syntax. Short timeouts everywhere: a bug must fail, not hang.
-#include "server/directory_source.h"
+#include "server/sources/directory_source.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,8 @@
 #include <vector>
 
 #include "common/io/cloud_io.h"
-#include "server/source_spec.h"
+#include "common/io/png_io.h"
+#include "server/sources/source_spec.h"
 
 namespace cornerpose::server {
 namespace {
@@ -144,6 +145,34 @@ TEST_F(DirectorySourceTest, DepthPngWithIntrinsicsIsAnOrganizedCloud) {
   EXPECT_TRUE(std::isnan(frame->cloud.xyz[5].z()));
   ASSERT_TRUE(frame->camera.has_value());
   EXPECT_EQ(frame->camera->width, 4);
+}
+
+// NAME.color.png is the colour of NAME.png, never a frame of its own; a
+// colour image of another size is not used (the frame plays depth-only).
+TEST_F(DirectorySourceTest, ColorPngBesideADepthPngIsThatFramesColour) {
+  ASSERT_TRUE(WriteDepthPng((dir_ / "a.png").string(), std::vector<uint16_t>(12, 1000), 4, 3).ok());
+  ASSERT_TRUE(WriteDepthPng((dir_ / "b.png").string(), std::vector<uint16_t>(12, 1500), 4, 3).ok());
+  std::ofstream(dir_ / "intrinsics.txt") << "4,3,2,2,1.5,1\n";
+  std::vector<uint8_t> rgb(4 * 3 * 3, 0);
+  rgb[0] = 0x12;  // pixel 0: R
+  rgb[4] = 0x34;  // pixel 1: G
+  ASSERT_TRUE(WriteRgbPng((dir_ / "a.color.png").string(), rgb, 4, 3).ok());
+  ASSERT_TRUE(
+      WriteRgbPng((dir_ / "b.color.png").string(), std::vector<uint8_t>(2 * 2 * 3), 2, 2).ok());
+
+  DirectorySource source("rgbd", dir_.string(), {.fps = 20, .loop = false});
+  std::vector<Frame> frames = Next(source, 2);
+  ASSERT_EQ(frames.size(), 2u);
+  // a.png (with its colour), then b.png (its colour has the wrong size).
+  EXPECT_NEAR(frames[0].cloud.xyz[0].z(), 1.0f, 1e-6);
+  ASSERT_TRUE(frames[0].cloud.has_color());
+  EXPECT_EQ(frames[0].cloud.rgb[0], 0x00120000u);
+  EXPECT_EQ(frames[0].cloud.rgb[1], 0x00003400u);
+  EXPECT_NEAR(frames[1].cloud.xyz[0].z(), 1.5f, 1e-6);
+  EXPECT_FALSE(frames[1].cloud.has_color());
+  // Only two frames: the colour images were not played.
+  absl::StatusOr<Frame> after = source.GrabNewerThan(frames.back().id, kWait);
+  EXPECT_EQ(after.status().code(), absl::StatusCode::kOutOfRange) << after.status();
 }
 
 TEST_F(DirectorySourceTest, PngWithoutIntrinsicsFailsTheSourceWithAReason) {

@@ -1,7 +1,7 @@
 // LoadServerConfig: every shipped configuration under deploy/ loads and
 // starts a real server (on 127.0.0.1:0) whose sources come up RUNNING, and
 // bad files fail with the right status.
-#include "server/server_config.h"
+#include "server/config/server_config.h"
 
 #include <gmock/gmock.h>
 #include <grpcpp/create_channel.h>

@@ -18,11 +18,10 @@
 #include <string>
 
 #include "common/perception/detector.h"
+#include "common/wire/cloud_wire.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "grpc/health/v1/health.grpc.pb.h"
-#include "server/conversion.h"
 #include "tests/support/scene_generator.h"
-#include "tools/client/response_conversion.h"
 
 namespace cornerpose::server {
 namespace {
@@ -52,17 +51,18 @@ const Frame& TheFrame() {
 
 v1::DetectRequest FrameRequest() {
   v1::DetectRequest request;
-  *request.mutable_cloud() = server::CloudToProto(TheFrame().scene.cloud);
+  *request.mutable_cloud() = wire::CloudToProto(TheFrame().scene.cloud);
   request.set_box_model("carton_s");
   return request;
 }
 
 class ServerTest : public ::testing::Test {
  protected:
-  void Start(int max_message_bytes = ServerOptions{}.max_message_bytes) {
+  void Start(int max_message_bytes = ServerOptions{}.max_message_bytes, BoxModels box_models = {}) {
     ServerOptions options;
     options.listen_address = "127.0.0.1:0";
     options.max_message_bytes = max_message_bytes;
+    options.box_models = std::move(box_models);
     absl::StatusOr<std::unique_ptr<RunningServer>> server = StartServer(options);
     ASSERT_TRUE(server.ok()) << server.status();
     server_ = *std::move(server);
@@ -133,6 +133,66 @@ TEST_F(ServerTest, DetectOnPackedCloudMatchesInProcessDetector) {
   s = Detect(with_edges, &response);
   ASSERT_TRUE(s.ok()) << s.error_message();
   EXPECT_EQ(response.edge_points_size(), static_cast<int>(expected.edge_points.size()));
+}
+
+// The server alone resolves model names (its configuration first) and says
+// what it used, so a client never plans with another size.
+TEST_F(ServerTest, ResponseSaysWhichBoxSizeTheDetectorUsed) {
+  Start(ServerOptions{}.max_message_bytes, {{"carton_s", {0.31, 0.21, 0.16}}});
+  v1::DetectRequest request;
+  request.mutable_cloud();  // empty: no boxes, quick
+  request.set_box_model("carton_s");
+  v1::DetectResponse response;
+  grpc::Status s = Detect(request, &response);
+  ASSERT_TRUE(s.ok()) << s.error_message();
+  EXPECT_EQ(response.box_dims_used().l(), 0.31);
+  EXPECT_EQ(response.box_dims_used().h(), 0.16);
+
+  request.set_box_model("brick");
+  ASSERT_TRUE(Detect(request, &response).ok());
+  EXPECT_EQ(response.box_dims_used().l(), 0.19);
+  EXPECT_EQ(response.box_dims_used().b(), 0.09);
+
+  request.mutable_box()->set_l(0.5);
+  request.mutable_box()->set_b(0.4);
+  request.mutable_box()->set_h(0.3);
+  ASSERT_TRUE(Detect(request, &response).ok());
+  EXPECT_EQ(response.box_dims_used().b(), 0.4);
+}
+
+TEST_F(ServerTest, ColourImageIsCheckedAgainstTheDepthImage) {
+  Start();
+  v1::DetectRequest request;
+  request.set_box_model("carton_s");
+  v1::DepthImage* image = request.mutable_depth_image();
+  image->set_width(2);
+  image->set_height(2);
+  image->set_encoding(v1::DEPTH_ENCODING_UINT16_MM);
+  image->set_data(std::string(8, '\0'));
+  v1::CameraIntrinsics* k = request.mutable_intrinsics();
+  k->set_width(2);
+  k->set_height(2);
+  k->set_fx(500);
+  k->set_fy(500);
+  v1::ColorImage* color = request.mutable_color();
+  color->set_width(3);
+  color->set_height(2);
+  color->set_encoding(v1::COLOR_ENCODING_GRAY8);
+  color->set_data(std::string(6, '\x80'));
+  v1::DetectResponse response;
+  grpc::Status s = Detect(request, &response);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(s.error_message(), HasSubstr("color is 3 x 2 but the cloud is 2 x 2"));
+
+  color->set_width(2);
+  color->set_data(std::string(4, '\x80'));
+  s = Detect(request, &response);
+  EXPECT_TRUE(s.ok()) << s.error_message();
+
+  request.set_source("anything");
+  s = Detect(request, &response);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(s.error_message(), HasSubstr("color is for a cloud or depth_image"));
 }
 
 TEST_F(ServerTest, DetectOnUint16DepthImageFindsBoxes) {

@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "robot_client/grasp_geometry.h"
-#include "robot_client/pick_plan.h"
-#include "robot_client/pick_selection.h"
-#include "robot_client/robot_config.h"
-#include "robot_client/urscript_program.h"
+#include "robot_client/config/robot_config.h"
+#include "robot_client/planning/grasp_geometry.h"
+#include "robot_client/planning/pick_plan.h"
+#include "robot_client/planning/pick_selection.h"
+#include "robot_client/planning/urscript_program.h"
 
 namespace cornerpose::robot_client {
 namespace {

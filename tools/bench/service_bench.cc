@@ -21,11 +21,10 @@
 #include <vector>
 
 #include "common/perception/detector.h"
+#include "common/wire/cloud_wire.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
-#include "server/conversion.h"
 #include "server/server.h"
 #include "tests/support/scene_generator.h"
-#include "tools/client/response_conversion.h"
 
 namespace cornerpose {
 namespace {
@@ -132,7 +131,7 @@ int Main(int argc, char** argv) {
   const std::string target = "127.0.0.1:" + std::to_string((*server)->port());
 
   v1::DetectRequest request;
-  *request.mutable_cloud() = server::CloudToProto(scene.cloud);
+  *request.mutable_cloud() = wire::CloudToProto(scene.cloud);
   request.set_box_model("carton_s");
 
   auto make_stub = [&] {

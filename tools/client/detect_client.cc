@@ -9,14 +9,14 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
+#include "common/box/box_models.h"
 #include "common/io/cloud_io.h"
-#include "common/perception/box_models.h"
+#include "common/wire/cloud_wire.h"
+#include "common/wire/detection_wire.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
-#include "server/conversion.h"
 #include "tools/client/client_commands.h"
 #include "tools/client/detection_outputs.h"
 #include "tools/client/request_options.h"
-#include "tools/client/response_conversion.h"
 #include "tools/client/rpc_channel.h"
 #include "tools/command_args.h"
 #include "tools/detect_command.h"
@@ -63,13 +63,7 @@ absl::Status Detect(const CommandArgs& args) {
     absl::StatusOr<CameraIntrinsics> parsed = ParseIntrinsics(*k);
     if (!parsed.ok()) return parsed.status();
     intrinsics = *parsed;
-    v1::CameraIntrinsics* ki = request.mutable_intrinsics();
-    ki->set_width(static_cast<uint32_t>(parsed->width));
-    ki->set_height(static_cast<uint32_t>(parsed->height));
-    ki->set_fx(parsed->fx);
-    ki->set_fy(parsed->fy);
-    ki->set_cx(parsed->cx);
-    ki->set_cy(parsed->cy);
+    *request.mutable_intrinsics() = wire::ToProto(*parsed);
   }
   if (cloud_path) {
     LoadOptions load;
@@ -77,7 +71,7 @@ absl::Status Detect(const CommandArgs& args) {
     absl::StatusOr<PointCloud> loaded = LoadPointCloud(*cloud_path, load);
     if (!loaded.ok()) return loaded.status();
     cloud = *std::move(loaded);
-    *request.mutable_cloud() = server::CloudToProto(cloud);
+    *request.mutable_cloud() = wire::CloudToProto(cloud);
   } else {
     request.set_source(*source);
     request.set_include_cloud(common->outputs.need_cloud());
@@ -91,7 +85,7 @@ absl::Status Detect(const CommandArgs& args) {
   v1::DetectResponse response;
   const grpc::Status rpc = stub->Detect(&context, request, &response);
   if (!rpc.ok()) return FromRpcStatus(rpc, *channel, common->server, common->deadline_ms);
-  absl::StatusOr<Detection> det = DetectionFromProto(response);
+  absl::StatusOr<Detection> det = wire::DetectionFromProto(response);
   if (!det.ok()) {
     return absl::InternalError(
         absl::StrCat("bad response from ", common->server, ": ", det.status().message()));
@@ -99,7 +93,7 @@ absl::Status Detect(const CommandArgs& args) {
   std::string label = cloud_path.value_or("");
   if (source) {
     label = absl::StrCat(*source, " frame ", response.frame_id());
-    absl::StatusOr<PointCloud> frame_cloud = server::CloudFromProto(response.cloud());
+    absl::StatusOr<PointCloud> frame_cloud = wire::CloudFromProto(response.cloud());
     if (!frame_cloud.ok()) {
       return absl::InternalError(
           absl::StrCat("bad cloud from ", common->server, ": ", frame_cloud.status().message()));
@@ -117,12 +111,7 @@ absl::Status Detect(const CommandArgs& args) {
 }  // namespace
 
 int RunClientDetect(const std::vector<std::string>& argv) {
-  for (const std::string& a : argv) {
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-  }
+  if (PrintHelpIfAsked(argv, kHelp)) return 0;
   absl::StatusOr<CommandArgs> args =
       ParseCommandArgs(argv,
                        {"server", "cloud", "source", "box", "intrinsics", "json", "ply", "png",

@@ -52,12 +52,7 @@ absl::Status Check(const CommandArgs& args) {
 }  // namespace
 
 int RunClientHealth(const std::vector<std::string>& argv) {
-  for (const std::string& a : argv) {
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-  }
+  if (PrintHelpIfAsked(argv, kHelp)) return 0;
   absl::StatusOr<CommandArgs> args =
       ParseCommandArgs(argv, {"server", "service", "deadline_ms"}, {"quiet"}, {"server"});
   if (!args.ok()) return ReportUsageError("health", args.status(), kHelp);

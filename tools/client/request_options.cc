@@ -4,7 +4,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "common/perception/box_models.h"
+#include "common/box/box_models.h"
 
 namespace cornerpose::tools {
 

@@ -8,6 +8,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "common/perception/types.h"
+#include "common/wire/box_wire.h"
 #include "tools/client/detection_outputs.h"
 #include "tools/command_args.h"
 
@@ -26,13 +27,11 @@ struct ClientRequestOptions {
 absl::StatusOr<ClientRequestOptions> ParseClientRequestOptions(const CommandArgs& args);
 
 // Sets the request's box: explicit dimensions for "L,B,H", else the model name
-// (the server knows the models).
+// (the server resolves the models; the response says what it used).
 template <typename Request>
 void SetBoxSize(const ClientRequestOptions& options, Request* request) {
   if (options.box_text.find(',') != std::string::npos) {
-    request->mutable_box()->set_l(options.box.l);
-    request->mutable_box()->set_b(options.box.b);
-    request->mutable_box()->set_h(options.box.h);
+    *request->mutable_box() = wire::ToProto(options.box);
   } else {
     request->set_box_model(options.box_text);
   }

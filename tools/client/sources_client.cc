@@ -48,12 +48,7 @@ absl::Status ListSources(const CommandArgs& args) {
 }  // namespace
 
 int RunClientSources(const std::vector<std::string>& argv) {
-  for (const std::string& a : argv) {
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-  }
+  if (PrintHelpIfAsked(argv, kHelp)) return 0;
   absl::StatusOr<CommandArgs> args =
       ParseCommandArgs(argv, {"server", "deadline_ms"}, {}, {"server"});
   if (!args.ok()) return ReportUsageError("sources", args.status(), kHelp);

@@ -10,12 +10,12 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
+#include "common/wire/cloud_wire.h"
+#include "common/wire/detection_wire.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
-#include "server/conversion.h"
 #include "tools/client/client_commands.h"
 #include "tools/client/detection_outputs.h"
 #include "tools/client/request_options.h"
-#include "tools/client/response_conversion.h"
 #include "tools/client/rpc_channel.h"
 #include "tools/command_args.h"
 #include "tools/detect_command.h"
@@ -91,13 +91,13 @@ absl::Status Stream(const CommandArgs& args) {
   int frames = 0;
   while (reader->Read(&response)) {
     ++frames;
-    absl::StatusOr<Detection> det = DetectionFromProto(response);
+    absl::StatusOr<Detection> det = wire::DetectionFromProto(response);
     if (!det.ok()) {
       context.TryCancel();
       return absl::InternalError(
           absl::StrCat("bad response from ", common->server, ": ", det.status().message()));
     }
-    absl::StatusOr<PointCloud> cloud = server::CloudFromProto(response.cloud());
+    absl::StatusOr<PointCloud> cloud = wire::CloudFromProto(response.cloud());
     if (!cloud.ok()) {
       context.TryCancel();
       return absl::InternalError(
@@ -133,12 +133,7 @@ absl::Status Stream(const CommandArgs& args) {
 }  // namespace
 
 int RunClientStream(const std::vector<std::string>& argv) {
-  for (const std::string& a : argv) {
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-  }
+  if (PrintHelpIfAsked(argv, kHelp)) return 0;
   absl::StatusOr<CommandArgs> args = ParseCommandArgs(
       argv, {"server", "source", "box", "frames", "json", "ply", "png", "edges", "deadline_ms"},
       {"quiet"}, {"server", "source", "box"});

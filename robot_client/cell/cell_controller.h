@@ -1,0 +1,119 @@
+// The daemon's main loop: keeps the controller link up, waits for a
+// detection from a frame captured after the last move, chooses a box, plans
+// the five waypoints, renders the program and runs it, then advances the
+// place slot. Stops (and says why) on a protective stop, a lost controller
+// or a lost perception stream, and resumes by itself once the condition
+// clears; never commands a pose outside the workspace (the planner refuses
+// one) and never uses a stale frame.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/time/time.h"
+#include "robot_client/cell/cell_state.h"
+#include "robot_client/cell/perception_subscriber.h"
+#include "robot_client/cell/robot_link.h"
+#include "robot_client/config/robot_config.h"
+
+namespace cornerpose::robot_client {
+
+struct CellControllerOptions {
+  // The longest one pick program may run before the pick counts as failed.
+  absl::Duration program_timeout = absl::Seconds(120);
+  // Bring-up (power on, brake release) limit.
+  absl::Duration bring_up_timeout = absl::Seconds(30);
+  // Between attempts to reconnect to the controller, and between checks
+  // while stopped.
+  absl::Duration retry_interval = absl::Milliseconds(500);
+  // How long to wait for a fresh frame before re-checking the robot.
+  absl::Duration frame_wait = absl::Milliseconds(500);
+  // Picks kept for ListPicks.
+  size_t max_records = 100;
+};
+
+// Called from the controller's thread.
+struct CellCallbacks {
+  std::function<void(const PickRecord&)> on_pick;
+  // A state change (with the reason when STOPPED).
+  std::function<void(const CellStatusSnapshot&)> on_state;
+  // Every rendered program (dry run prints them).
+  std::function<void(const std::string& name, const std::string& text)> on_program;
+  // Why a frame gave no pick, and other notes for the log.
+  std::function<void(const std::string& message)> on_note;
+};
+
+class CellController {
+ public:
+  CellController(RobotClientOptions options, CellControllerOptions controller,
+                 PerceptionSubscriber* perception, CellCallbacks callbacks = {});
+
+  // Runs until Stop(), or until the pattern is full / max_picks are made.
+  void Run();
+  // Thread-safe; Run returns after the current step (a running program is
+  // followed to its end).
+  void Stop();
+
+  CellStatusSnapshot Status() const;
+  // The newest `max` picks (0 = all kept), oldest first.
+  std::vector<PickRecord> Picks(size_t max = 0) const;
+
+ private:
+  // A planned, rendered pick, ready to run.
+  struct PreparedPick {
+    PickRecord record;
+    std::string program;
+  };
+
+  // One pass of the loop, in the phases below; false when the cell is
+  // finished.
+  bool Step();
+  // The newest frame captured after the last move (each judged once), or
+  // nullopt (with the state saying why when the stream is down).
+  std::optional<FrameDetection> AwaitFreshFrame();
+  // Where the arm is (dry run: the clear pose); nullopt without a state.
+  std::optional<ur::Joints> CurrentJoints();
+  // Selection, planning (the best box that plans) and the program of one
+  // frame; nullopt, with a note saying why, when the frame gives no pick.
+  std::optional<PreparedPick> PreparePick(const FrameDetection& frame, const ur::Joints& joints,
+                                          int slot);
+  // Runs the program (dry run: records it) and records the outcome.
+  void RunPick(PreparedPick pick);
+  void Note(const std::string& message);
+  // Whether the robot can take a program now; sets STOPPED and waits when not.
+  bool RobotReady();
+  // Whether the gripper's suction output is on in `state`.
+  bool SuctionOn(const ur::RtdeState& state) const;
+  void SetState(CellState state, const std::string& reason = "");
+  void Record(PickRecord record);
+  // Sleeps up to `d` unless stopped.
+  void Pause(absl::Duration d);
+
+  const RobotClientOptions options_;
+  const CellControllerOptions controller_;
+  PerceptionSubscriber* const perception_;
+  const CellCallbacks callbacks_;
+  RobotLink link_;
+  const Reachability reachable_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable stop_cv_;
+  bool stopping_ = false;           // guarded by mutex_
+  CellStatusSnapshot status_;       // guarded by mutex_
+  std::deque<PickRecord> records_;  // guarded by mutex_
+
+  // Loop state (controller thread only).
+  // Frames captured at or before this are not used: the end of the last
+  // move (the arm may have been in view, the scene has changed), or a frame
+  // already judged.
+  absl::Time not_before_;
+  uint64_t next_pick_id_ = 1;
+};
+
+}  // namespace cornerpose::robot_client

@@ -1,0 +1,96 @@
+// The daemon's view of the perception service: one StreamDetections call on
+// a background thread, re-opened with exponential back-off whenever it ends
+// (the service restarted, the network dropped), keeping only the newest
+// detection. The cell asks for a detection from a frame captured after its
+// last move, so a frame that saw the arm, or the box it has just taken, is
+// never used.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/time/time.h"
+#include "common/box/box_types.h"
+
+namespace grpc {
+class ClientContext;
+}
+
+namespace cornerpose::robot_client {
+
+struct PerceptionSubscriberOptions {
+  // host:port of the cornerpose perception service.
+  std::string server = "localhost:50051";
+  // The service's frame source to subscribe to.
+  std::string source;
+  // The box size: a model the service knows (e.g. "carton_s"), or explicit
+  // dimensions when `box` is set (then box_model is ignored).
+  std::string box_model;
+  std::optional<BoxDims> box;
+  // Back-off between attempts to (re)open the stream: starts at `initial`,
+  // doubles per failed attempt up to `max`, resets once a frame arrives.
+  absl::Duration initial_backoff = absl::Milliseconds(200);
+  absl::Duration max_backoff = absl::Seconds(5);
+};
+
+// One frame's detected boxes and where they came from.
+struct FrameDetection {
+  // Best score first.
+  std::vector<DetectedBox> boxes;
+  // The size the server detected with (it resolves model names); unset
+  // from a server that does not say.
+  std::optional<BoxDims> box_dims;
+  std::string source;
+  uint64_t frame_id = 0;
+  absl::Time capture_time;
+};
+
+class PerceptionSubscriber {
+ public:
+  explicit PerceptionSubscriber(PerceptionSubscriberOptions options);
+  // Cancels the stream and joins the thread.
+  ~PerceptionSubscriber();
+  PerceptionSubscriber(const PerceptionSubscriber&) = delete;
+  PerceptionSubscriber& operator=(const PerceptionSubscriber&) = delete;
+
+  // Starts the background stream (once).
+  void Start();
+  // Cancels the stream; Wait* return nullopt from then on.
+  void Stop();
+
+  // The newest detection of a frame captured strictly after `not_before`,
+  // waiting up to `timeout` for one; nullopt when none came.
+  std::optional<FrameDetection> WaitForFrameAfter(absl::Time not_before, absl::Duration timeout);
+
+  // True while the stream is open and has delivered a frame.
+  bool connected() const;
+  // Why the last stream ended (empty before any failure).
+  std::string last_error() const;
+  // Detections received since Start.
+  uint64_t frames_received() const;
+
+ private:
+  void Run();
+  // Sleeps up to `d` unless stopped; false when stopped.
+  bool SleepUnlessStopped(absl::Duration d);
+
+  const PerceptionSubscriberOptions options_;
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  bool started_ = false;                    // guarded by mutex_
+  bool stopping_ = false;                   // guarded by mutex_
+  bool connected_ = false;                  // guarded by mutex_
+  std::string last_error_;                  // guarded by mutex_
+  uint64_t frames_received_ = 0;            // guarded by mutex_
+  std::optional<FrameDetection> latest_;    // guarded by mutex_
+  grpc::ClientContext* context_ = nullptr;  // guarded by mutex_; the open call
+  std::thread thread_;
+};
+
+}  // namespace cornerpose::robot_client

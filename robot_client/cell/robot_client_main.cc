@@ -1,0 +1,160 @@
+// cornerpose_robot_client: the robot-cell daemon. Subscribes to a
+// perception service's detections, picks boxes with a UR arm and places them
+// on a pattern, and serves its state (cornerpose.v1.RobotClientService and
+// gRPC health) for operators and monitoring.
+//
+//   cornerpose_robot_client --config deploy/config/robot_client.textproto
+//       [--server HOST:PORT] [--source NAME] [--robot_host HOST] [--dry_run]
+//
+// Flags given override the file. Prints one line per pick and per state
+// change; runs until the place pattern is full, max_picks are made, or
+// SIGINT / SIGTERM (a running program is followed to its end first).
+#include <semaphore.h>
+
+#include <csignal>
+#include <cstdio>
+#include <string>
+#include <thread>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
+#include "robot_client/cell/cell_controller.h"
+#include "robot_client/cell/perception_subscriber.h"
+#include "robot_client/cell/status_service.h"
+#include "robot_client/config/robot_config.h"
+
+ABSL_FLAG(std::string, config, "",
+          "the configuration file (cornerpose.v1.RobotClientConfig, protobuf text format); "
+          "required");
+ABSL_FLAG(std::string, server, "", "host:port of the perception service (overrides the file)");
+ABSL_FLAG(std::string, source, "", "the perception service's frame source (overrides the file)");
+ABSL_FLAG(std::string, robot_host, "", "the UR controller's host (overrides the file)");
+ABSL_FLAG(int, dashboard_port, 0, "the controller's dashboard port (overrides the file)");
+ABSL_FLAG(int, primary_port, 0, "the controller's primary interface port (overrides the file)");
+ABSL_FLAG(int, rtde_port, 0, "the controller's RTDE port (overrides the file)");
+ABSL_FLAG(std::string, status_listen, "",
+          "host:port of the status service (overrides the file; port 0 picks one)");
+ABSL_FLAG(bool, dry_run, false, "print the programs instead of sending them");
+ABSL_FLAG(int, max_picks, -1, "stop after this many picks (overrides the file; 0 = no limit)");
+
+namespace {
+
+// Posted by SIGINT / SIGTERM (sem_post is async-signal-safe).
+sem_t stop_requested;
+
+void OnStopSignal(int /*signal*/) { sem_post(&stop_requested); }
+
+std::string Timestamp() {
+  return absl::FormatTime("%H:%M:%E3S", absl::Now(), absl::LocalTimeZone());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace cornerpose::robot_client;  // NOLINT: a main file
+  absl::SetProgramUsageMessage(
+      "The robot-cell daemon: detections in, URScript pick-and-place programs out.");
+  absl::ParseCommandLine(argc, argv);
+  const std::string config = absl::GetFlag(FLAGS_config);
+  if (config.empty()) {
+    std::fprintf(stderr, "cornerpose_robot_client: --config FILE is required\n");
+    return 2;
+  }
+  absl::StatusOr<RobotClientOptions> loaded = LoadRobotClientConfig(config);
+  if (!loaded.ok()) {
+    std::fprintf(stderr, "cornerpose_robot_client: %s\n", loaded.status().ToString().c_str());
+    return 1;
+  }
+  RobotClientOptions options = *std::move(loaded);
+  if (const std::string v = absl::GetFlag(FLAGS_server); !v.empty()) {
+    options.perception.server_address = v;
+  }
+  if (const std::string v = absl::GetFlag(FLAGS_source); !v.empty()) options.perception.source = v;
+  if (const std::string v = absl::GetFlag(FLAGS_robot_host); !v.empty()) options.robot.host = v;
+  if (const int v = absl::GetFlag(FLAGS_dashboard_port); v > 0) options.robot.dashboard_port = v;
+  if (const int v = absl::GetFlag(FLAGS_primary_port); v > 0) options.robot.primary_port = v;
+  if (const int v = absl::GetFlag(FLAGS_rtde_port); v > 0) options.robot.rtde_port = v;
+  if (const std::string v = absl::GetFlag(FLAGS_status_listen); !v.empty()) {
+    options.status_listen_address = v;
+  }
+  if (absl::GetFlag(FLAGS_dry_run)) options.dry_run = true;
+  if (const int v = absl::GetFlag(FLAGS_max_picks); v >= 0) options.max_picks = v;
+  if (absl::Status s = options.Validate(); !s.ok()) {
+    std::fprintf(stderr, "cornerpose_robot_client: %s\n", s.ToString().c_str());
+    return 1;
+  }
+
+  sem_init(&stop_requested, /*pshared=*/0, /*value=*/0);
+  struct sigaction action = {};
+  action.sa_handler = OnStopSignal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+
+  PerceptionSubscriberOptions perception;
+  perception.server = options.perception.server_address;
+  perception.source = options.perception.source;
+  perception.box_model = options.perception.box_model;
+  if (options.perception.box_model.empty()) perception.box = options.perception.box;
+  perception.initial_backoff = absl::Seconds(options.perception.reconnect_initial_s);
+  perception.max_backoff = absl::Seconds(options.perception.reconnect_max_s);
+  PerceptionSubscriber subscriber(perception);
+
+  CellCallbacks callbacks;
+  callbacks.on_pick = [](const PickRecord& pick) {
+    std::printf("%s %s\n", Timestamp().c_str(), DescribePick(pick).c_str());
+    std::fflush(stdout);
+  };
+  callbacks.on_state = [](const CellStatusSnapshot& status) {
+    std::printf("%s cell %s%s%s\n", Timestamp().c_str(), CellStateName(status.state),
+                status.stop_reason.empty() ? "" : ": ", status.stop_reason.c_str());
+    std::fflush(stdout);
+  };
+  callbacks.on_note = [](const std::string& note) {
+    std::printf("%s %s\n", Timestamp().c_str(), note.c_str());
+    std::fflush(stdout);
+  };
+  const bool dry_run = options.dry_run;
+  callbacks.on_program = [dry_run](const std::string& name, const std::string& text) {
+    if (!dry_run) return;
+    std::printf("%s program %s (dry run, not sent):\n%s", Timestamp().c_str(), name.c_str(),
+                text.c_str());
+    std::fflush(stdout);
+  };
+  const std::string status_address = options.status_listen_address;
+  std::printf("%s cornerpose_robot_client: perception %s source '%s', robot %s (%s), %s\n",
+              Timestamp().c_str(), options.perception.server_address.c_str(),
+              options.perception.source.c_str(), options.robot.host.c_str(),
+              dry_run ? "dry run" : "live", status_address.c_str());
+  CellController cell(std::move(options), CellControllerOptions{}, &subscriber, callbacks);
+
+  absl::StatusOr<std::unique_ptr<StatusServer>> status = StartStatusServer(status_address, &cell);
+  if (!status.ok()) {
+    std::fprintf(stderr, "cornerpose_robot_client: %s\n", status.status().ToString().c_str());
+    return 1;
+  }
+  std::printf("%s status service on port %d\n", Timestamp().c_str(), (*status)->port());
+  std::fflush(stdout);
+
+  // The signal thread stops the cell; a finished cell wakes it through the
+  // same semaphore.
+  std::thread stopper([&] {
+    while (sem_wait(&stop_requested) != 0) {
+    }
+    cell.Stop();
+    subscriber.Stop();
+  });
+  subscriber.Start();
+  cell.Run();
+  sem_post(&stop_requested);
+  stopper.join();
+  (*status)->Shutdown();
+  const CellStatusSnapshot end = cell.Status();
+  std::printf("%s stopped: %d picks done, %d failed\n", Timestamp().c_str(), end.picks_done,
+              end.picks_failed);
+  return 0;
+}

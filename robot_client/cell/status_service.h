@@ -1,0 +1,57 @@
+// The daemon's status service (cornerpose.v1.RobotClientService) and gRPC
+// health checking, on their own small gRPC server: thin handlers over the
+// cell controller's snapshot and pick log.
+#pragma once
+
+#include <grpcpp/server.h>
+
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "cornerpose/v1/robot_client_service.grpc.pb.h"
+#include "robot_client/cell/cell_controller.h"
+
+namespace cornerpose::robot_client {
+
+class StatusServiceImpl final : public v1::RobotClientService::CallbackService {
+ public:
+  explicit StatusServiceImpl(const CellController* cell) : cell_(cell) {}
+
+  grpc::ServerUnaryReactor* GetCellStatus(grpc::CallbackServerContext* context,
+                                          const v1::GetCellStatusRequest* request,
+                                          v1::CellStatus* response) override;
+  grpc::ServerUnaryReactor* ListPicks(grpc::CallbackServerContext* context,
+                                      const v1::ListPicksRequest* request,
+                                      v1::ListPicksResponse* response) override;
+
+ private:
+  const CellController* const cell_;
+};
+
+// The proto forms of the controller's snapshot and records.
+v1::CellStatus ToProto(const CellStatusSnapshot& status);
+v1::PickRecord ToProto(const PickRecord& pick);
+
+// A running status server; shuts down when destroyed.
+class StatusServer {
+ public:
+  ~StatusServer();
+  int port() const { return port_; }
+  // Marks health NOT_SERVING and stops serving (idempotent).
+  void Shutdown();
+
+ private:
+  friend absl::StatusOr<std::unique_ptr<StatusServer>> StartStatusServer(
+      const std::string& listen_address, const CellController* cell);
+  std::unique_ptr<StatusServiceImpl> service_;
+  std::unique_ptr<grpc::Server> server_;
+  int port_ = 0;
+};
+
+// Listens on `listen_address` (host:port; port 0 picks one). UNAVAILABLE
+// when the address cannot be bound.
+absl::StatusOr<std::unique_ptr<StatusServer>> StartStatusServer(const std::string& listen_address,
+                                                                const CellController* cell);
+
+}  // namespace cornerpose::robot_client

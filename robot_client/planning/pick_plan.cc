@@ -1,0 +1,217 @@
+#include "robot_client/planning/pick_plan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "robot_client/planning/place_pattern.h"
+
+namespace cornerpose::robot_client {
+namespace {
+
+// In-face sides within this of each other make a square face: four place
+// orientations instead of two.
+constexpr double kSquareToleranceM = 1e-3;
+
+std::string Xyz(const Eigen::Vector3d& p) {
+  return absl::StrFormat("(%.3f, %.3f, %.3f)", p.x(), p.y(), p.z());
+}
+
+// slot_T_box for every allowed place orientation of the box: grasp face up
+// (its normal along slot z), bottom centre at the slot origin, the face's
+// longer side along slot +-x.
+std::vector<Eigen::Isometry3d> PlaceOrientations(BoxFace face, const BoxDims& dims) {
+  const int axis = static_cast<int>(face) / 2;
+  const int a = (axis + 1) % 3;
+  const int b = (axis + 2) % 3;
+  const bool square = std::abs(dims[a] - dims[b]) < kSquareToleranceM;
+  const int longer = dims[b] > dims[a] + kSquareToleranceM ? b : a;
+  const Eigen::Vector3d n = BoxFaceNormal(face);
+  const Eigen::Vector3d l = Eigen::Vector3d::Unit(longer);
+  Eigen::Matrix3d slot_R_box;
+  slot_R_box.row(0) = l.transpose();
+  slot_R_box.row(1) = n.cross(l).transpose();
+  slot_R_box.row(2) = n.transpose();
+  std::vector<Eigen::Isometry3d> out;
+  for (int quarter = 0; quarter < 4; quarter += square ? 1 : 2) {
+    Eigen::Isometry3d slot_T_box = Eigen::Isometry3d::Identity();
+    slot_T_box.linear() =
+        Eigen::AngleAxisd(quarter * 0.5 * 3.14159265358979323846, Eigen::Vector3d::UnitZ())
+            .toRotationMatrix() *
+        slot_R_box;
+    slot_T_box.translation() = Eigen::Vector3d(0, 0, 0.5 * dims[axis]);
+    out.push_back(slot_T_box);
+  }
+  return out;
+}
+
+double RotationBetween(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return ur::RotationAngleBetween(Eigen::Quaterniond(a.linear()), Eigen::Quaterniond(b.linear()));
+}
+
+// The waypoints of one choice of grasp and place orientation.
+PickPlan Waypoints(const Eigen::Isometry3d& initial, const BoxInBase& box,
+                   const Eigen::Isometry3d& grasp, const Eigen::Isometry3d& base_T_slot,
+                   const Eigen::Isometry3d& slot_T_box, int slot,
+                   const WaypointOptions& waypoints) {
+  PickPlan plan;
+  plan.initial = initial;
+  plan.grasp = grasp;
+  plan.approach = RaisedAlongBaseZ(grasp, waypoints.approach_distance_m);
+  plan.retrieve = RaisedAlongBaseZ(grasp, waypoints.retrieve_height_m);
+  plan.slot = slot;
+  plan.base_T_slot = base_T_slot;
+  plan.box = box;
+  plan.tcp_T_box = grasp.inverse() * box.base_T_box;
+  plan.base_T_box_placed = base_T_slot * slot_T_box;
+  plan.place = plan.base_T_box_placed * plan.tcp_T_box.inverse();
+  plan.place_above = RaisedAlongBaseZ(plan.place, waypoints.place_approach_height_m);
+  plan.grasp_rotation_rad = RotationBetween(initial, grasp);
+  plan.place_rotation_rad = RotationBetween(grasp, plan.place);
+  return plan;
+}
+
+// The commanded waypoints with their names, in program order.
+std::vector<std::pair<const char*, const Eigen::Isometry3d*>> Commanded(const PickPlan& plan) {
+  return {{"M (approach)", &plan.approach},
+          {"G (grasp)", &plan.grasp},
+          {"R (retrieve)", &plan.retrieve},
+          {"place_above", &plan.place_above},
+          {"F (place)", &plan.place}};
+}
+
+// The joints a movej to `pose` ends with: the IK solution nearest `from`.
+absl::Status FreeMove(const PickArm& arm, const char* name, const Eigen::Isometry3d& pose,
+                      const ur::Joints& from, ur::Joints* to) {
+  absl::StatusOr<ur::Joints> q =
+      ur::InverseKinematics(arm.model, pose * arm.flange_T_tcp.inverse(), from);
+  if (!q.ok()) {
+    return absl::FailedPreconditionError(
+        absl::StrFormat("waypoint %s at %s is not reachable", name, Xyz(pose.translation())));
+  }
+  *to = *q;
+  return absl::OkStatus();
+}
+
+absl::Status StraightMove(const PickArm& arm, const char* name, const Eigen::Isometry3d& from,
+                          const Eigen::Isometry3d& to, const ur::Joints& from_joints,
+                          ur::Joints* to_joints) {
+  absl::Status status = CheckStraightMove(arm.model, arm.flange_T_tcp, from_joints, from, to,
+                                          arm.straight_moves, to_joints);
+  if (status.ok() || status.code() != absl::StatusCode::kFailedPrecondition) return status;
+  return absl::FailedPreconditionError(absl::StrCat("straight move ", name, " ", status.message()));
+}
+
+// The pick half as the controller runs it: I -> M (movej), M -> G, G -> R.
+absl::Status SimulatePick(const PickArm& arm, PickPlan& plan) {
+  plan.initial_joints = arm.joints;
+  absl::Status status =
+      FreeMove(arm, "M (approach)", plan.approach, plan.initial_joints, &plan.approach_joints);
+  if (status.ok()) {
+    status = StraightMove(arm, "M->G (grasp)", plan.approach, plan.grasp, plan.approach_joints,
+                          &plan.grasp_joints);
+  }
+  if (status.ok()) {
+    status = StraightMove(arm, "G->R (retrieve)", plan.grasp, plan.retrieve, plan.grasp_joints,
+                          &plan.retrieve_joints);
+  }
+  return status;
+}
+
+// The place half: R -> place_above (movej), place_above -> F and back.
+absl::Status SimulatePlace(const PickArm& arm, PickPlan& plan) {
+  absl::Status status = FreeMove(arm, "place_above", plan.place_above, plan.retrieve_joints,
+                                 &plan.place_above_joints);
+  if (status.ok()) {
+    status = StraightMove(arm, "place_above->F (place)", plan.place_above, plan.place,
+                          plan.place_above_joints, &plan.place_joints);
+  }
+  if (status.ok()) {
+    ur::Joints back;
+    status = StraightMove(arm, "F->place_above (leave)", plan.place, plan.place_above,
+                          plan.place_joints, &back);
+  }
+  return status;
+}
+
+}  // namespace
+
+absl::StatusOr<PickPlan> PlanPick(const PickArm& arm, const BoxInBase& box, const BoxDims& dims,
+                                  const Eigen::Isometry3d& base_T_slot, int slot,
+                                  const WaypointOptions& waypoints, const Workspace& workspace) {
+  const Eigen::Isometry3d initial = TcpPoseFromJoints(arm.model, arm.joints, arm.flange_T_tcp);
+  const std::array<Eigen::Isometry3d, 4> grasps =
+      GraspCandidates(box, Eigen::Quaterniond(initial.linear()));
+  const std::vector<Eigen::Isometry3d> places = PlaceOrientations(box.grasp_face, dims);
+
+  // Positions do not depend on the orientation choice: one workspace check.
+  {
+    const PickPlan plan =
+        Waypoints(initial, box, grasps[0], base_T_slot, places[0], slot, waypoints);
+    for (const auto& [name, pose] : Commanded(plan)) {
+      if (!workspace.Contains(pose->translation())) {
+        return absl::FailedPreconditionError(
+            absl::StrFormat("waypoint %s at %s is outside the workspace %s .. %s", name,
+                            Xyz(pose->translation()), Xyz(workspace.min_m), Xyz(workspace.max_m)));
+      }
+    }
+  }
+
+  absl::Status first_failure;
+  for (const Eigen::Isometry3d& grasp : grasps) {
+    // Place orientations by least rotation from this grasp.
+    std::vector<PickPlan> candidates;
+    for (const Eigen::Isometry3d& slot_T_box : places) {
+      candidates.push_back(
+          Waypoints(initial, box, grasp, base_T_slot, slot_T_box, slot, waypoints));
+    }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const PickPlan& a, const PickPlan& b) {
+                       return a.place_rotation_rad < b.place_rotation_rad;
+                     });
+    // The pick half is the same for every place orientation.
+    absl::Status status = SimulatePick(arm, candidates.front());
+    if (!status.ok()) {
+      if (status.code() != absl::StatusCode::kFailedPrecondition) return status;
+      if (first_failure.ok()) first_failure = status;
+      continue;
+    }
+    for (PickPlan& plan : candidates) {
+      plan.initial_joints = candidates.front().initial_joints;
+      plan.approach_joints = candidates.front().approach_joints;
+      plan.grasp_joints = candidates.front().grasp_joints;
+      plan.retrieve_joints = candidates.front().retrieve_joints;
+      status = SimulatePlace(arm, plan);
+      if (status.ok()) return plan;
+      if (status.code() != absl::StatusCode::kFailedPrecondition) return status;
+      if (first_failure.ok()) first_failure = status;
+    }
+  }
+  return absl::FailedPreconditionError(
+      absl::StrCat(first_failure.message(), " (nor with any other tool rotation)"));
+}
+
+absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
+                                         const ur::Joints& current_joints, const BoxInBase& box,
+                                         int slot) {
+  return PlanPickForSlot(options, current_joints, box, slot, options.perception.box);
+}
+
+absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
+                                         const ur::Joints& current_joints, const BoxInBase& box,
+                                         int slot, const BoxDims& dims) {
+  absl::StatusOr<Eigen::Isometry3d> base_T_slot = SlotPose(options.place_pattern, slot);
+  if (!base_T_slot.ok()) return base_T_slot.status();
+  PickArm arm;
+  arm.model = options.robot.arm_model;
+  arm.flange_T_tcp = options.gripper.flange_T_tcp;
+  arm.joints = current_joints;
+  arm.straight_moves.linear_speed_m_s = options.motion.linear_speed_m_s;
+  return PlanPick(arm, box, dims, *base_T_slot, slot, options.waypoints, options.workspace);
+}
+
+}  // namespace cornerpose::robot_client

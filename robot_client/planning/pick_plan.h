@@ -1,0 +1,107 @@
+// The paper's five pick-and-place waypoints (section 5) for one box, as TCP
+// poses in the base frame (what URScript's pose literals carry once the
+// program has done set_tcp(tcp_offset)):
+//
+//   I  the current TCP pose, FK(current joints) * flange_T_tcp
+//   M  = G + d * base z         approach point; I -> M is a free move
+//   G  the grasp: TCP at the grasp face centre, tool z into the face (along
+//      -normal), tool x along one of the face's box axes: of the four, the
+//      one needing the least wrist rotation from I; M -> G is straight
+//   R  = G + h * base z         retrieve, straight up from G
+//   place_above = F + a * base z, reached by a free move from R
+//   F  the place: the TCP pose that puts the held box's bottom centre on the
+//      slot, grasped face up, the face's longer side along the slot's x axis
+//      (of the two, or four for a square face, such box orientations the one
+//      needing the least wrist rotation from G); place_above -> F is straight.
+//
+// The controller runs the program from the arm's current joints: a movej to
+// a pose takes the inverse kinematics solution nearest the joints it starts
+// from, a movel follows the straight line (CheckStraightMove). The planner
+// replays that, so a plan it returns has every straight move (M -> G,
+// G -> R, place_above -> F and back) clear of singularities and branch flips.
+#pragma once
+
+#include <Eigen/Geometry>
+
+#include "absl/status/statusor.h"
+#include "common/box/box_types.h"
+#include "robot_client/config/robot_config.h"
+#include "robot_client/planning/grasp_geometry.h"
+#include "robot_client/planning/straight_move.h"
+#include "robot_client/ur/kinematics.h"
+
+namespace cornerpose::robot_client {
+
+struct PickPlan {
+  // base_T_tcp of each waypoint.
+  Eigen::Isometry3d initial = Eigen::Isometry3d::Identity();      // I
+  Eigen::Isometry3d approach = Eigen::Isometry3d::Identity();     // M
+  Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();        // G
+  Eigen::Isometry3d retrieve = Eigen::Isometry3d::Identity();     // R
+  Eigen::Isometry3d place_above = Eigen::Isometry3d::Identity();  // above F
+  Eigen::Isometry3d place = Eigen::Isometry3d::Identity();        // F
+  // The place pattern slot F fills, and its pose (the box's bottom centre).
+  int slot = 0;
+  Eigen::Isometry3d base_T_slot = Eigen::Isometry3d::Identity();
+  // The box as picked, and where it ends up (base_T_box at F).
+  BoxInBase box;
+  Eigen::Isometry3d base_T_box_placed = Eigen::Isometry3d::Identity();
+  // The held box in the tool frame, from G on.
+  Eigen::Isometry3d tcp_T_box = Eigen::Isometry3d::Identity();
+  // Tool rotation I -> G and G -> F, radians in [0, pi].
+  double grasp_rotation_rad = 0.0;
+  double place_rotation_rad = 0.0;
+  // The joints the controller reaches each waypoint with (see above); the
+  // return move F -> place_above ends within the straight-move bound of
+  // place_above_joints.
+  ur::Joints initial_joints{};
+  ur::Joints approach_joints{};
+  ur::Joints grasp_joints{};
+  ur::Joints retrieve_joints{};
+  ur::Joints place_above_joints{};
+  ur::Joints place_joints{};
+};
+
+// The arm that runs the plan, and where it is now.
+struct PickArm {
+  ur::ArmModel model = ur::ArmModel::kUr5e;
+  // The TCP in the flange frame (GripperOptions::flange_T_tcp).
+  Eigen::Isometry3d flange_T_tcp = Eigen::Isometry3d::Identity();
+  // The current joints; I = FK(joints) * flange_T_tcp.
+  ur::Joints joints{};
+  // How straight moves are checked; linear_speed_m_s should be the
+  // program's (MotionOptions::linear_speed_m_s).
+  StraightMoveOptions straight_moves;
+};
+
+// Plans the waypoints for `box` (a box of size `dims`, see BoxToBase) into
+// the slot at base_T_slot, starting from arm.joints. Tries the grasps in
+// order of least wrist rotation from I, and for each the place orientations
+// in order of least rotation from G, and returns the first the controller
+// can run: M and place_above have an IK solution (the one nearest the
+// joints before the movej is taken) and every straight move passes
+// CheckStraightMove from the joints the previous move ends with.
+// FAILED_PRECONDITION naming the waypoint when one lies outside `workspace`
+// (e.g. "waypoint R (retrieve) at (0.100, -0.500, 0.900) is outside the
+// workspace ...") or, when no orientation works, naming the first failure
+// of the preferred choice: "waypoint M (approach) at (...) is not
+// reachable" or "straight move G->R (retrieve) passes a singularity at
+// (...): ..." (the moves: M->G (grasp), G->R (retrieve), place_above->F
+// (place), F->place_above (leave)).
+absl::StatusOr<PickPlan> PlanPick(const PickArm& arm, const BoxInBase& box, const BoxDims& dims,
+                                  const Eigen::Isometry3d& base_T_slot, int slot,
+                                  const WaypointOptions& waypoints, const Workspace& workspace);
+
+// The daemon's entry point: PlanPick with the configured arm model, the
+// gripper's TCP offset, `current_joints`, the motion's linear speed and the
+// slot pose from the place pattern (RESOURCE_EXHAUSTED when `slot` is past
+// its end), for a box of `dims` (the size the server detected with).
+absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
+                                         const ur::Joints& current_joints, const BoxInBase& box,
+                                         int slot, const BoxDims& dims);
+// The same for the configured box size, options.perception.box.
+absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
+                                         const ur::Joints& current_joints, const BoxInBase& box,
+                                         int slot);
+
+}  // namespace cornerpose::robot_client

@@ -1,0 +1,163 @@
+#include "server/service/perception_service.h"
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "server/service/detect_request.h"
+#include "server/service/detect_response.h"
+#include "server/service/status_mapping.h"
+#include "server/service/stream_detections.h"
+
+namespace cornerpose::server {
+namespace {
+
+// OK while the caller still wants the answer. Checked before and after the
+// detector (which cannot be interrupted), so a request that waited in the
+// queue past its deadline costs no detection, and a late one no conversion.
+grpc::Status CheckStillWanted(grpc::CallbackServerContext& context) {
+  if (context.deadline() <= std::chrono::system_clock::now()) {
+    return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, "deadline exceeded");
+  }
+  if (context.IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
+  return grpc::Status::OK;
+}
+
+// The longest a Detect waits for a source's first frame (a replay starting,
+// a camera warming up); also capped by the caller's deadline. It blocks a pool
+// worker meanwhile, so it is short.
+constexpr absl::Duration kMaxFrameWait = absl::Seconds(2);
+
+v1::SourceState ToProto(SourceState state) {
+  switch (state) {
+    case SourceState::kStarting:
+      return v1::SOURCE_STATE_STARTING;
+    case SourceState::kRunning:
+      return v1::SOURCE_STATE_RUNNING;
+    case SourceState::kFailed:
+      return v1::SOURCE_STATE_FAILED;
+    case SourceState::kFinished:
+      return v1::SOURCE_STATE_FINISHED;
+  }
+  return v1::SOURCE_STATE_UNSPECIFIED;
+}
+
+// The newest frame of the named source. NOT_FOUND for an unknown name;
+// UNAVAILABLE when the source failed or has no frame in time.
+absl::StatusOr<Frame> GrabFromSource(
+    const std::map<std::string, std::unique_ptr<FrameSource>>& sources, const std::string& name,
+    grpc::CallbackServerContext& context) {
+  auto it = sources.find(name);
+  if (it == sources.end()) {
+    return absl::NotFoundError(absl::StrCat("unknown source '", name, "'"));
+  }
+  const absl::Duration until_deadline = absl::FromChrono(context.deadline()) - absl::Now();
+  return it->second->Grab(std::min(kMaxFrameWait, until_deadline));
+}
+
+grpc::Status RunDetect(grpc::CallbackServerContext& context, const v1::DetectRequest& request,
+                       const DetectorOptions& defaults, const BoxModels& box_models,
+                       const std::map<std::string, std::unique_ptr<FrameSource>>& sources,
+                       v1::DetectResponse& response) {
+  if (grpc::Status s = CheckStillWanted(context); !s.ok()) return s;
+  absl::StatusOr<DetectorOptions> options =
+      DetectorOptionsFromRequest(request, defaults, box_models);
+  if (!options.ok()) return ToGrpcStatus(options.status());
+  std::optional<Frame> frame;
+  absl::StatusOr<PointCloud> sent;
+  const PointCloud* cloud = nullptr;
+  if (request.input_case() == v1::DetectRequest::kSource) {
+    if (request.has_color()) {
+      return ToGrpcStatus(absl::InvalidArgumentError(
+          "color is for a cloud or depth_image sent with the request; a source's frames bring "
+          "their own"));
+    }
+    absl::StatusOr<Frame> grabbed = GrabFromSource(sources, request.source(), context);
+    if (!grabbed.ok()) return ToGrpcStatus(grabbed.status());
+    frame = *std::move(grabbed);
+    cloud = &frame->cloud;
+    // The source knows its camera; the request's intrinsics do not apply.
+    UseFrameCamera(frame->camera, &*options);
+  } else {
+    sent = CloudFromRequest(request);
+    if (!sent.ok()) return ToGrpcStatus(sent.status());
+    cloud = &*sent;
+  }
+  if (grpc::Status s = CheckStillWanted(context); !s.ok()) return s;
+
+  absl::StatusOr<Detection> detection = DetectBoxes(*cloud, *options);
+  if (!detection.ok()) return ToGrpcStatus(detection.status());
+
+  if (grpc::Status s = CheckStillWanted(context); !s.ok()) return s;
+  response = MakeDetectResponse(*detection, *options, frame ? &*frame : nullptr,
+                                {.include_edge_points = request.include_edge_points(),
+                                 .include_cloud = request.include_cloud()});
+  return grpc::Status::OK;
+}
+
+}  // namespace
+
+PerceptionServiceImpl::PerceptionServiceImpl(DetectionPool* pool, DetectorOptions defaults,
+                                             std::vector<std::unique_ptr<FrameSource>> sources,
+                                             BoxModels box_models)
+    : pool_(pool), defaults_(std::move(defaults)), box_models_(std::move(box_models)) {
+  for (std::unique_ptr<FrameSource>& source : sources) {
+    const std::string name = source->name();
+    sources_.emplace(name, std::move(source));
+  }
+}
+
+grpc::ServerUnaryReactor* PerceptionServiceImpl::Detect(grpc::CallbackServerContext* context,
+                                                        const v1::DetectRequest* request,
+                                                        v1::DetectResponse* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  // context, request and response stay valid until Finish.
+  pool_->Submit([this, context, request, response, reactor] {
+    reactor->Finish(RunDetect(*context, *request, defaults_, box_models_, sources_, *response));
+  });
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* PerceptionServiceImpl::ListSources(
+    grpc::CallbackServerContext* context, const v1::ListSourcesRequest* /*request*/,
+    v1::ListSourcesResponse* response) {
+  // Cheap (a lock per source), so answered on the callback thread.
+  for (const auto& [name, source] : sources_) {
+    v1::Source* out = response->add_sources();
+    out->set_name(name);
+    out->set_description(source->description());
+    const SourceStatus status = source->state();
+    out->set_state(ToProto(status.state));
+    out->set_state_reason(status.reason);
+  }
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  reactor->Finish(grpc::Status::OK);
+  return reactor;
+}
+
+}  // namespace cornerpose::server
+
+namespace cornerpose::server {
+
+grpc::ServerWriteReactor<v1::DetectResponse>* PerceptionServiceImpl::StreamDetections(
+    grpc::CallbackServerContext* /*context*/, const v1::StreamDetectionsRequest* request) {
+  absl::StatusOr<DetectorOptions> options =
+      DetectorOptionsFromRequest(*request, defaults_, box_models_);
+  if (!options.ok()) return new StreamDetectionsReactor(ToGrpcStatus(options.status()));
+  auto it = sources_.find(request->source());
+  if (it == sources_.end()) {
+    return new StreamDetectionsReactor(ToGrpcStatus(
+        absl::NotFoundError(absl::StrCat("unknown source '", request->source(), "'"))));
+  }
+  return new StreamDetectionsReactor(pool_, it->second.get(), *std::move(options),
+                                     {.include_edge_points = request->include_edge_points(),
+                                      .include_cloud = request->include_cloud()},
+                                     &stopping_streams_);
+}
+
+}  // namespace cornerpose::server

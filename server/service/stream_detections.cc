@@ -1,0 +1,107 @@
+#include "server/service/stream_detections.h"
+
+#include <future>
+#include <utility>
+
+#include "absl/time/clock.h"
+#include "server/service/status_mapping.h"
+
+namespace cornerpose::server {
+namespace {
+
+// How often a stream waiting for a frame checks for cancel and shutdown.
+constexpr absl::Duration kPollPeriod = absl::Milliseconds(100);
+
+}  // namespace
+
+StreamDetectionsReactor::StreamDetectionsReactor(const grpc::Status& error) { Finish(error); }
+
+StreamDetectionsReactor::StreamDetectionsReactor(DetectionPool* pool, FrameSource* source,
+                                                 DetectorOptions options, ResponseContents contents,
+                                                 const std::atomic<bool>* stopping)
+    : pool_(pool),
+      source_(source),
+      options_(std::move(options)),
+      contents_(contents),
+      stopping_(stopping) {
+  thread_ = std::thread([this] { Run(); });
+}
+
+void StreamDetectionsReactor::OnWriteDone(bool ok) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    write_pending_ = false;
+    write_ok_ = ok;
+  }
+  changed_.notify_all();
+}
+
+void StreamDetectionsReactor::OnCancel() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cancelled_ = true;
+  }
+  changed_.notify_all();
+}
+
+void StreamDetectionsReactor::OnDone() {
+  // Finish is Run's last act, but OnDone may run inside it on that thread.
+  if (thread_.joinable()) {
+    if (thread_.get_id() == std::this_thread::get_id()) {
+      thread_.detach();
+    } else {
+      thread_.join();
+    }
+  }
+  delete this;
+}
+
+grpc::Status StreamDetectionsReactor::ShouldStop() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (cancelled_) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
+  if (!write_ok_) return grpc::Status(grpc::StatusCode::CANCELLED, "the client went away");
+  if (stopping_->load()) {
+    return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
+  }
+  return grpc::Status::OK;
+}
+
+void StreamDetectionsReactor::Run() {
+  uint64_t last_id = 0;
+  grpc::Status end;
+  while ((end = ShouldStop()).ok()) {
+    absl::StatusOr<Frame> frame = source_->GrabNewerThan(last_id, kPollPeriod);
+    if (!frame.ok()) {
+      if (frame.status().code() == absl::StatusCode::kOutOfRange) break;  // played once: done
+      if (source_->state().state == SourceState::kFailed) {
+        end = ToGrpcStatus(frame.status());
+        break;
+      }
+      continue;  // no new frame yet
+    }
+    last_id = frame->id;
+
+    std::promise<absl::StatusOr<Detection>> done;
+    std::future<absl::StatusOr<Detection>> detection = done.get_future();
+    DetectorOptions options = options_;
+    UseFrameCamera(frame->camera, &options);  // as Detect does
+    pool_->Submit([&] { done.set_value(DetectBoxes(frame->cloud, options)); });
+    absl::StatusOr<Detection> result = detection.get();
+    if (!result.ok()) {
+      end = ToGrpcStatus(result.status());
+      break;
+    }
+    response_ = MakeDetectResponse(*result, options, &*frame, contents_);
+
+    std::unique_lock<std::mutex> lock(mutex_);
+    write_pending_ = true;
+    lock.unlock();
+    StartWrite(&response_);
+    // gRPC calls OnWriteDone for every write, also after a cancel.
+    lock.lock();
+    changed_.wait(lock, [&] { return !write_pending_; });
+  }
+  Finish(end);
+}
+
+}  // namespace cornerpose::server
