@@ -24,3 +24,13 @@ target_link_libraries(cell_sim PRIVATE cornerpose_cell_sim absl::flags absl::fla
 cornerpose_warnings(cell_sim)
 cornerpose_test(cell_world_test SOURCES ${PROJECT_SOURCE_DIR}/tests/cell_sim/cell_world_test.cc
                 LIBS cornerpose_cell_sim)
+# The closed loop through scripts/demo (cell_sim, the service over gRPC with
+# the virtual OpenNI2 camera, the daemon over TCP), one case per test.
+foreach(case pallet bin protective_stop)
+  add_test(NAME closed_loop_${case}
+           COMMAND python3 ${PROJECT_SOURCE_DIR}/tests/cell_sim/closed_loop_test.py
+                   ${PROJECT_SOURCE_DIR} ${case})
+  set_tests_properties(closed_loop_${case} PROPERTIES
+                       ENVIRONMENT "CORNERPOSE_BUILD_DIR=${PROJECT_BINARY_DIR}"
+                       TIMEOUT 480 LABELS "closed_loop" RUN_SERIAL TRUE)
+endforeach()

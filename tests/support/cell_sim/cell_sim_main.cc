@@ -5,6 +5,7 @@
 // directory that the virtual OpenNI2 camera serves to cornerpose_server
 // (`cornerpose://virtual?follow=1`). Prints one line per pick and keeps a
 // JSON report of every pick and the world's state.
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -17,7 +18,7 @@
 #include "absl/flags/usage.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "common/perception/box_models.h"
+#include "common/box/box_models.h"
 #include "tests/support/cell_sim/sim_camera.h"
 #include "tests/support/cell_sim/sim_cell.h"
 #include "tests/support/ur_emulator/ur_emulator.h"
@@ -44,6 +45,9 @@ ABSL_FLAG(std::string, write_robot_config, "",
           "Write the daemon's configuration for this cell (textproto) to this file.");
 ABSL_FLAG(std::string, source, "sim", "The perception source name the daemon's configuration uses.");
 ABSL_FLAG(bool, config_only, false, "Write --write_robot_config and exit.");
+ABSL_FLAG(int, protective_stop_after, 0,
+          "Fault injection: once this many boxes are placed, a protective stop on the arm "
+          "during the next program (0 = none). An operator clears it on the dashboard.");
 
 namespace {
 
@@ -161,6 +165,10 @@ int main(int argc, char** argv) {
   }
 
   const std::string report = absl::GetFlag(FLAGS_report);
+  // Set by the pick listener (the controller's thread); the stop itself is
+  // injected from the main thread, into the program that follows.
+  const int stop_after = absl::GetFlag(FLAGS_protective_stop_after);
+  std::atomic<bool> stop_armed{false};
   const std::string description = cell->description;
   world->SetPickListener([&](const cell_sim::PickEvent& p, const cell_sim::WorldSummary& s) {
     const int failed = static_cast<int>(std::count_if(s.picks.begin(), s.picks.end(), [](auto& e) {
@@ -173,6 +181,9 @@ int main(int argc, char** argv) {
                 p.wait_before_s, s.placed, s.boxes_total, s.in_pile, failed, s.collisions);
     std::fflush(stdout);
     if (!report.empty()) WriteAtomically(report, ReportJson(description, s, world->Boxes()).dump(1));
+    if (stop_after > 0 && s.placed == stop_after && p.result == cell_sim::PickResult::kPlaced) {
+      stop_armed = true;
+    }
   });
   if (!report.empty()) {
     WriteAtomically(report, ReportJson(description, world->Summary(), world->Boxes()).dump(1));
@@ -186,7 +197,20 @@ int main(int argc, char** argv) {
               options.time_scale, cell_options.camera_height_m, camera_options.sensor.c_str(),
               camera_options.directory.c_str());
   std::fflush(stdout);
-  while (!g_stop) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  bool stop_injected = false;
+  while (!g_stop) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (stop_armed && !stop_injected && (*emulator)->controller().Snapshot().program_running) {
+      // A simulated second into the next program: the arm is on its way to the
+      // approach point, nothing on the cup.
+      std::this_thread::sleep_for(
+          std::chrono::milliseconds(static_cast<int>(1000.0 / options.time_scale)));
+      (*emulator)->TriggerProtectiveStop();
+      stop_injected = true;
+      std::printf("sim: protective stop injected (after %d placed)\n", stop_after);
+      std::fflush(stdout);
+    }
+  }
   std::printf("cell_sim: stopping\n");
   return 0;
 }

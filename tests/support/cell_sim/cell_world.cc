@@ -109,9 +109,13 @@ testing::Scene CellWorld::CurrentScene(uint32_t noise_seed) const {
   scene.supports = layout_.supports;
   scene.floor = true;
   scene.noise_seed = noise_seed;
-  for (const SimBox& box : boxes_) {
+  for (size_t i = 0; i < boxes_.size(); ++i) {
     if (scene.boxes.size() >= 254) break;  // the renderer's instance labels
-    scene.boxes.push_back({box.dims, box.world_T_box, true});
+    // The held box goes with the arm, which is not rendered either: a frame
+    // taken while it rises shows the pile without it, never a box hovering
+    // a centimetre above its old place (the detector would report it there).
+    if (static_cast<int>(i) == held_) continue;
+    scene.boxes.push_back({boxes_[i].dims, boxes_[i].world_T_box, true});
   }
   return scene;
 }
