@@ -60,7 +60,21 @@ absl::Status SelectionOptions::Validate() const {
     return s;
   }
   if (absl::Status s = CheckRange("selection.min_score", min_score, 0.0, 1.0); !s.ok()) return s;
-  return CheckRange("selection.height_tie_m", height_tie_m, 0.0, 1.0);
+  if (absl::Status s = CheckRange("selection.height_tie_m", height_tie_m, 0.0, 1.0); !s.ok()) {
+    return s;
+  }
+  if (absl::Status s = CheckRange("selection.max_overlap_m", max_overlap_m, 0.0, 1.0); !s.ok()) {
+    return s;
+  }
+  if (absl::Status s = CheckRange("selection.layer_tolerance_m", layer_tolerance_m, 1e-4, 1.0);
+      !s.ok()) {
+    return s;
+  }
+  if (min_layer_for_face_check < 0 || min_layer_for_face_check > 1000) {
+    return Invalid(absl::StrCat("selection.min_layer_for_face_check is ", min_layer_for_face_check,
+                                "; must be in [0, 1000]"));
+  }
+  return absl::OkStatus();
 }
 
 absl::Status GripperOptions::Validate() const {
@@ -91,7 +105,12 @@ absl::Status WaypointOptions::Validate() const {
       !s.ok()) {
     return s;
   }
-  return CheckPositive("waypoints.place_approach_height_m", place_approach_height_m, 2.0);
+  if (absl::Status s =
+          CheckPositive("waypoints.place_approach_height_m", place_approach_height_m, 2.0);
+      !s.ok()) {
+    return s;
+  }
+  return CheckRange("waypoints.pile_clearance_m", pile_clearance_m, 0.0, 1.0);
 }
 
 absl::Status PlacePatternOptions::Validate() const {

@@ -83,6 +83,20 @@ struct SelectionOptions {
   // Grasp points closer in height than this are equally high (the higher
   // score wins), metres; >= 0.
   double height_tie_m = 0.01;
+  // Declines a box whose footprint (its extent in base x, y) overlaps
+  // another detected box's of the same layer (tops within layer_tolerance_m)
+  // by more than this in both x and y, metres; >= 0. Two boxes cannot share
+  // space: one of the two is misplaced (a centre off along its length), so
+  // both are declined until a later frame separates them.
+  double max_overlap_m = 0.02;
+  // Tops closer in height than this are one layer, metres; > 0.
+  double layer_tolerance_m = 0.03;
+  // In a frame of at least this many boxes, a box whose grasp face is a
+  // different face of the box model (its size along the normal differs by
+  // more than layer_tolerance_m from what two thirds of the boxes in view
+  // have) is declined: the detector took the wrong face size, so the box's
+  // bottom, and where it is put down, would be wrong. 0 = no such check.
+  int min_layer_for_face_check = 3;
 
   absl::Status Validate() const;
 };
@@ -112,6 +126,11 @@ struct WaypointOptions {
   double retrieve_height_m = 0.25;
   // place_above = F + this * base z, metres; > 0.
   double place_approach_height_m = 0.10;
+  // Clearance above the pile, metres, in [0, 1]: when the frame's boxes give
+  // the pile's top (the highest detected box top), M is at least this above
+  // it and R lifts the held box's bottom at least this above it (d and h
+  // above are the minimums).
+  double pile_clearance_m = 0.05;
 
   absl::Status Validate() const;
 };

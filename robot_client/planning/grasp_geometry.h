@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <functional>
+#include <limits>
 
 #include "common/box/box_types.h"
 #include "robot_client/ur/kinematics.h"
@@ -39,6 +40,10 @@ struct BoxInBase {
   double depth_m = 0.0;
   // Angle between grasp_normal and base +z, degrees.
   double tilt_deg = 0.0;
+  // The pile's top in the frame this box came from: the highest point of
+  // any detected box, base z, metres (SelectPick sets it); NaN = unknown,
+  // and the planner then uses the fixed waypoint heights.
+  double pile_top_z_m = std::numeric_limits<double>::quiet_NaN();
 };
 
 // camera_T_box and the grasp face of `box`, moved to the base frame; the

@@ -1,7 +1,10 @@
 #include "robot_client/planning/pick_plan.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,6 +19,7 @@ namespace {
 // In-face sides within this of each other make a square face: four place
 // orientations instead of two.
 constexpr double kSquareToleranceM = 1e-3;
+constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
 
 std::string Xyz(const Eigen::Vector3d& p) {
   return absl::StrFormat("(%.3f, %.3f, %.3f)", p.x(), p.y(), p.z());
@@ -53,6 +57,24 @@ double RotationBetween(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return ur::RotationAngleBetween(Eigen::Quaterniond(a.linear()), Eigen::Quaterniond(b.linear()));
 }
 
+}  // namespace
+
+double ApproachDistance(const BoxInBase& box, const WaypointOptions& waypoints) {
+  if (!std::isfinite(box.pile_top_z_m)) return waypoints.approach_distance_m;
+  return std::max(waypoints.approach_distance_m,
+                  box.pile_top_z_m + waypoints.pile_clearance_m - box.grasp_point.z());
+}
+
+double RetrieveHeight(const BoxInBase& box, const WaypointOptions& waypoints) {
+  if (!std::isfinite(box.pile_top_z_m)) return waypoints.retrieve_height_m;
+  // The held box's bottom (depth_m below the cup) clear of the pile's top:
+  // a low box next to a high one is lifted past it before the free move.
+  return std::max(waypoints.retrieve_height_m, box.pile_top_z_m + waypoints.pile_clearance_m +
+                                                   box.depth_m - box.grasp_point.z());
+}
+
+namespace {
+
 // The waypoints of one choice of grasp and place orientation.
 PickPlan Waypoints(const Eigen::Isometry3d& initial, const BoxInBase& box,
                    const Eigen::Isometry3d& grasp, const Eigen::Isometry3d& base_T_slot,
@@ -61,8 +83,8 @@ PickPlan Waypoints(const Eigen::Isometry3d& initial, const BoxInBase& box,
   PickPlan plan;
   plan.initial = initial;
   plan.grasp = grasp;
-  plan.approach = RaisedAlongBaseZ(grasp, waypoints.approach_distance_m);
-  plan.retrieve = RaisedAlongBaseZ(grasp, waypoints.retrieve_height_m);
+  plan.approach = RaisedAlongBaseZ(grasp, ApproachDistance(box, waypoints));
+  plan.retrieve = RaisedAlongBaseZ(grasp, RetrieveHeight(box, waypoints));
   plan.slot = slot;
   plan.base_T_slot = base_T_slot;
   plan.box = box;
@@ -84,16 +106,77 @@ std::vector<std::pair<const char*, const Eigen::Isometry3d*>> Commanded(const Pi
           {"F (place)", &plan.place}};
 }
 
-// The joints a movej to `pose` ends with: the IK solution nearest `from`.
+// The configuration branch of a joint vector: which of the (up to 8) IK
+// solutions of one flange pose it is. reach: the wrist centre in front of
+// (+1) or behind (-1) the shoulder along the arm's heading (behind = the
+// upper arm over the shoulder); elbow: sign of q3. These two decide where
+// the upper and lower arm sweep, so free moves keep them; the wrist (sign of
+// sin q5) may flip in a free move (q4, q6 turn by pi: a local motion), but
+// the joint-space cost below makes a flip the last resort.
+struct Branch {
+  int reach = 1, elbow = 1;
+  bool operator==(const Branch&) const = default;
+};
+
+int Sign(double v) { return v < 0.0 ? -1 : 1; }
+
+Branch BranchOf(ur::ArmModel model, const ur::Joints& q) {
+  const ur::DhParameters& dh = ur::NominalDh(model);
+  // Horizontal reach of the wrist from the shoulder in the arm's plane (UR
+  // DH: a2, a3 < 0, so a straight arm pointing along the heading has q2 = pi).
+  const double reach = -(dh.a[1] * std::cos(q[1]) + dh.a[2] * std::cos(q[1] + q[2]));
+  return {Sign(reach), Sign(std::remainder(q[2], kTwoPi))};
+}
+
+// `angle` shifted by 2 pi multiples to the value nearest `near` within
+// +-limit; nullopt when none is.
+std::optional<double> NearestTurn(double angle, double near, double limit) {
+  const double base = near + std::remainder(angle - near, kTwoPi);
+  for (double v : {base, base - kTwoPi, base + kTwoPi}) {
+    if (std::abs(v) <= limit) return v;
+  }
+  return std::nullopt;
+}
+
+// The joints a movej to `pose` ends with: the program commands the IK
+// solution on the reference branch nearest `from` (Euclidean in joint
+// space), each angle the turn nearest `from` within the joint limits.
 absl::Status FreeMove(const PickArm& arm, const char* name, const Eigen::Isometry3d& pose,
                       const ur::Joints& from, ur::Joints* to) {
-  absl::StatusOr<ur::Joints> q =
-      ur::InverseKinematics(arm.model, pose * arm.flange_T_tcp.inverse(), from);
-  if (!q.ok()) {
+  const ur::IkOptions ik;
+  const std::vector<ur::Joints> solutions =
+      ur::InverseKinematicsAll(arm.model, pose * arm.flange_T_tcp.inverse(), ik);
+  if (solutions.empty()) {
     return absl::FailedPreconditionError(
         absl::StrFormat("waypoint %s at %s is not reachable", name, Xyz(pose.translation())));
   }
-  *to = *q;
+  const Branch want = BranchOf(arm.model, arm.branch_reference.value_or(arm.joints));
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (const ur::Joints& solution : solutions) {
+    if (!(BranchOf(arm.model, solution) == want)) continue;
+    ur::Joints q{};
+    bool within = true;
+    double cost = 0.0;
+    for (int i = 0; i < 6 && within; ++i) {
+      const std::optional<double> v = NearestTurn(solution[i], from[i], ik.joint_limit_rad);
+      if (!v) {
+        within = false;
+        break;
+      }
+      q[i] = *v;
+      cost += (q[i] - from[i]) * (q[i] - from[i]);
+    }
+    if (within && cost < best_cost) {
+      best_cost = cost;
+      *to = q;
+    }
+  }
+  if (!std::isfinite(best_cost)) {
+    return absl::FailedPreconditionError(absl::StrFormat(
+        "waypoint %s at %s is reachable only on another configuration branch (shoulder or "
+        "elbow flipped from the clear pose's)",
+        name, Xyz(pose.translation())));
+  }
   return absl::OkStatus();
 }
 
@@ -210,6 +293,7 @@ absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
   arm.model = options.robot.arm_model;
   arm.flange_T_tcp = options.gripper.flange_T_tcp;
   arm.joints = current_joints;
+  arm.branch_reference = options.clear_joints;
   arm.straight_moves.linear_speed_m_s = options.motion.linear_speed_m_s;
   return PlanPick(arm, box, dims, *base_T_slot, slot, options.waypoints, options.workspace);
 }

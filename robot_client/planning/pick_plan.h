@@ -14,14 +14,22 @@
 //      (of the two, or four for a square face, such box orientations the one
 //      needing the least wrist rotation from G); place_above -> F is straight.
 //
-// The controller runs the program from the arm's current joints: a movej to
-// a pose takes the inverse kinematics solution nearest the joints it starts
-// from, a movel follows the straight line (CheckStraightMove). The planner
-// replays that, so a plan it returns has every straight move (M -> G,
-// G -> R, place_above -> F and back) clear of singularities and branch flips.
+// Free moves are joint-space moves (movej to a joint vector) to the IK
+// solution on the arm's configuration branch (PickArm::branch_reference:
+// same shoulder and elbow as the clear pose) nearest the joints the
+// move starts from, each angle within the joint limits, so the arm never
+// swings over its shoulder to reach a place behind it. A movel follows the
+// straight line (CheckStraightMove). The planner replays the program, so a
+// plan it returns has every straight move (M -> G, G -> R, place_above -> F
+// and back) clear of singularities and branch flips.
+//
+// Heights come from the pile when the box carries its top
+// (BoxInBase::pile_top_z_m): M at least pile_clearance_m above the pile's
+// top, R high enough that the held box's bottom clears it by as much.
 #pragma once
 
 #include <Eigen/Geometry>
+#include <optional>
 
 #include "absl/status/statusor.h"
 #include "common/box/box_types.h"
@@ -69,6 +77,10 @@ struct PickArm {
   Eigen::Isometry3d flange_T_tcp = Eigen::Isometry3d::Identity();
   // The current joints; I = FK(joints) * flange_T_tcp.
   ur::Joints joints{};
+  // The configuration branch every free move stays on (shoulder and elbow:
+  // the signs that tell the IK solutions apart up to a wrist flip), given by a
+  // joint vector on it, normally the clear pose; unset = that of `joints`.
+  std::optional<ur::Joints> branch_reference;
   // How straight moves are checked; linear_speed_m_s should be the
   // program's (MotionOptions::linear_speed_m_s).
   StraightMoveOptions straight_moves;
@@ -92,8 +104,16 @@ absl::StatusOr<PickPlan> PlanPick(const PickArm& arm, const BoxInBase& box, cons
                                   const Eigen::Isometry3d& base_T_slot, int slot,
                                   const WaypointOptions& waypoints, const Workspace& workspace);
 
+// The approach distance d (M = G + d z) and retrieve height h (R = G + h z)
+// for `box`: approach_distance_m and retrieve_height_m, raised when the
+// box's pile_top_z_m is known and higher: M at least pile_clearance_m above
+// the pile's top, R with the held box's bottom pile_clearance_m above it.
+double ApproachDistance(const BoxInBase& box, const WaypointOptions& waypoints);
+double RetrieveHeight(const BoxInBase& box, const WaypointOptions& waypoints);
+
 // The daemon's entry point: PlanPick with the configured arm model, the
-// gripper's TCP offset, `current_joints`, the motion's linear speed and the
+// gripper's TCP offset, `current_joints`, the clear pose as the branch
+// reference, the motion's linear speed and the
 // slot pose from the place pattern (RESOURCE_EXHAUSTED when `slot` is past
 // its end), for a box of `dims` (the size the server detected with).
 absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,

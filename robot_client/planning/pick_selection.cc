@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <string>
 #include <limits>
 #include <utility>
 
 #include "absl/strings/str_format.h"
+#include "robot_client/planning/pick_plan.h"
 
 namespace cornerpose::robot_client {
 namespace {
@@ -18,14 +21,16 @@ std::string Xyz(const Eigen::Vector3d& p) {
 // reachable; otherwise why the first (least wrist rotation) grasp fails.
 std::string CheckPickWaypoints(const BoxInBase& box, const Workspace& workspace,
                                const WaypointOptions& waypoints, const Reachability& reachable) {
+  const double approach = ApproachDistance(box, waypoints);
+  const double retrieve = RetrieveHeight(box, waypoints);
   const std::array<Eigen::Isometry3d, 4> grasps =
       GraspCandidates(box, Eigen::Quaterniond::Identity());
   // Positions are the same for all four grasps: test the workspace once.
   const Eigen::Isometry3d& g = grasps[0];
   const std::array<std::pair<const char*, Eigen::Isometry3d>, 3> points = {{
       {"grasp point G", g},
-      {"approach point M", RaisedAlongBaseZ(g, waypoints.approach_distance_m)},
-      {"retrieve point R", RaisedAlongBaseZ(g, waypoints.retrieve_height_m)},
+      {"approach point M", RaisedAlongBaseZ(g, approach)},
+      {"retrieve point R", RaisedAlongBaseZ(g, retrieve)},
   }};
   for (const auto& [name, pose] : points) {
     if (!workspace.Contains(pose.translation())) {
@@ -35,7 +40,7 @@ std::string CheckPickWaypoints(const BoxInBase& box, const Workspace& workspace,
   if (!reachable) return "";
   for (const Eigen::Isometry3d& grasp : grasps) {
     bool all = true;
-    for (double height : {0.0, waypoints.approach_distance_m, waypoints.retrieve_height_m}) {
+    for (double height : {0.0, approach, retrieve}) {
       if (!reachable(RaisedAlongBaseZ(grasp, height))) {
         all = false;
         break;
@@ -45,6 +50,105 @@ std::string CheckPickWaypoints(const BoxInBase& box, const Workspace& workspace,
   }
   return absl::StrFormat("grasp at %s is not reachable (G, M or R, every tool rotation)",
                          Xyz(g.translation()));
+}
+
+// A detected box as the pile sees it: its highest point and its footprint,
+// the rectangle it covers in base x, y (centre, unit axes, half sides).
+struct Footprint {
+  double top_z = 0.0;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  std::array<Eigen::Vector2d, 2> axis;
+  std::array<double, 2> half{};
+};
+
+Footprint FootprintOf(const BoxInBase& box, const BoxDims& dims) {
+  const Eigen::Matrix3d& R = box.base_T_box.linear();
+  Footprint f;
+  f.top_z = box.base_T_box.translation().z();
+  for (int k = 0; k < 3; ++k) f.top_z += 0.5 * dims[k] * std::abs(R(2, k));
+  // The box axis nearest base z is the footprint's normal; the other two span it.
+  int up = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (std::abs(R(2, k)) > std::abs(R(2, up))) up = k;
+  }
+  f.centre = box.base_T_box.translation().head<2>();
+  for (int j = 0; j < 2; ++j) {
+    const int k = (up + 1 + j) % 3;
+    const Eigen::Vector2d a = R.col(k).head<2>();
+    f.axis[j] = a.norm() > 1e-9 ? Eigen::Vector2d(a.normalized()) : Eigen::Vector2d::UnitX();
+    f.half[j] = 0.5 * dims[k] * a.norm();
+  }
+  return f;
+}
+
+// How deep two footprints overlap: the smallest overlap of their
+// projections over the four side directions (separating axes); <= 0 when
+// they are apart.
+double OverlapDepth(const Footprint& a, const Footprint& b) {
+  double depth = std::numeric_limits<double>::infinity();
+  for (const Footprint* f : {&a, &b}) {
+    for (const Eigen::Vector2d& n : f->axis) {
+      auto extent = [&](const Footprint& g) {
+        return g.half[0] * std::abs(g.axis[0].dot(n)) + g.half[1] * std::abs(g.axis[1].dot(n));
+      };
+      const double ca = a.centre.dot(n), cb = b.centre.dot(n);
+      const double ea = extent(a), eb = extent(b);
+      depth = std::min(depth, std::min(ca + ea, cb + eb) - std::max(ca - ea, cb - eb));
+    }
+  }
+  return depth;
+}
+
+// Why the pile contradicts box i (empty when it does not): it shares space
+// with another box of its layer, or its grasp face is not the face most of
+// its layer show (a wrong face size: its depth, and so its bottom, is off).
+std::string CheckAgainstPile(size_t i, const std::vector<BoxVerdict>& verdicts,
+                             const std::vector<Footprint>& footprints,
+                             const SelectionOptions& selection) {
+  const Footprint& f = footprints[i];
+  std::vector<size_t> layer;
+  for (size_t j = 0; j < footprints.size(); ++j) {
+    if (std::abs(footprints[j].top_z - f.top_z) <= selection.layer_tolerance_m) layer.push_back(j);
+  }
+  for (size_t j : layer) {
+    if (j == i) continue;
+    const double depth = OverlapDepth(f, footprints[j]);
+    if (depth > selection.max_overlap_m) {
+      return absl::StrFormat("overlaps box #%d of its layer by %.3f m (max %.3f): one of the two "
+                             "is misplaced",
+                             verdicts[j].index, depth, selection.max_overlap_m);
+    }
+  }
+  // The face check looks at the whole frame: the visible boxes of a pallet
+  // (its top layer and the exposed edges of the ones below) lie alike.
+  if (selection.min_layer_for_face_check > 0 &&
+      static_cast<int>(verdicts.size()) >= selection.min_layer_for_face_check) {
+    const double depth_i = verdicts[i].box.depth_m;
+    int agree = 0;
+    int best_agree = 0;
+    double best_depth = depth_i;
+    for (size_t j = 0; j < verdicts.size(); ++j) {
+      int n = 0;
+      for (const BoxVerdict& other : verdicts) {
+        if (std::abs(other.box.depth_m - verdicts[j].box.depth_m) <= selection.layer_tolerance_m) {
+          ++n;
+        }
+      }
+      if (j == i) agree = n;
+      if (n > best_agree) {
+        best_agree = n;
+        best_depth = verdicts[j].box.depth_m;
+      }
+    }
+    // Declined only when a clear majority shows another face.
+    if (3 * best_agree >= 2 * static_cast<int>(verdicts.size()) && agree < best_agree &&
+        std::abs(best_depth - depth_i) > selection.layer_tolerance_m) {
+      return absl::StrFormat("grasp face is %.3f m deep, but %d of the %d boxes in view show a "
+                             "face %.3f m deep: the wrong face size",
+                             depth_i, best_agree, static_cast<int>(verdicts.size()), best_depth);
+    }
+  }
+  return "";
 }
 
 }  // namespace
@@ -60,17 +164,50 @@ PickSelection SelectPick(const std::vector<DetectedBox>& boxes,
     verdict.index = static_cast<int>(i);
     verdict.score = boxes[i].score;
     verdict.box = BoxToBase(boxes[i], base_T_camera, dims);
+    result.verdicts.push_back(std::move(verdict));
+  }
+  // The pile's top: the highest point of any detected box.
+  std::vector<Footprint> footprints;
+  double pile_top = std::numeric_limits<double>::quiet_NaN();
+  for (const BoxVerdict& v : result.verdicts) {
+    footprints.push_back(FootprintOf(v.box, dims));
+    if (!(pile_top >= footprints.back().top_z)) pile_top = footprints.back().top_z;
+  }
+  // A layer's boxes share one top: with at least three of one depth in a
+  // layer, each grasp point takes the layer's median top, which averages
+  // away the sensor's depth steps (about 1 cm at 1.4 m for a Kinect).
+  std::vector<double> snap(boxes.size(), 0.0);
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    std::vector<double> tops;
+    for (size_t j = 0; j < boxes.size(); ++j) {
+      if (std::abs(footprints[j].top_z - footprints[i].top_z) <= selection.layer_tolerance_m &&
+          std::abs(result.verdicts[j].box.depth_m - result.verdicts[i].box.depth_m) <= 1e-3 &&
+          result.verdicts[j].box.tilt_deg <= selection.max_grasp_tilt_deg) {
+        tops.push_back(footprints[j].top_z);
+      }
+    }
+    if (tops.size() < 3) continue;
+    std::nth_element(tops.begin(), tops.begin() + tops.size() / 2, tops.end());
+    snap[i] = tops[tops.size() / 2] - footprints[i].top_z;
+  }
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    BoxVerdict& verdict = result.verdicts[i];
+    verdict.box.pile_top_z_m = pile_top;
+    verdict.box.base_T_box.translation().z() += snap[i];
+    verdict.box.grasp_point.z() += snap[i];
     if (!(boxes[i].score >= selection.min_score)) {
       verdict.reason = absl::StrFormat("score %.3f is below min_score %.3f", boxes[i].score,
                                        selection.min_score);
     } else if (!(verdict.box.tilt_deg <= selection.max_grasp_tilt_deg)) {
       verdict.reason = absl::StrFormat("grasp face tilted %.1f deg from base +z (max %.1f)",
                                        verdict.box.tilt_deg, selection.max_grasp_tilt_deg);
+    } else if (std::string pile = CheckAgainstPile(i, result.verdicts, footprints, selection);
+               !pile.empty()) {
+      verdict.reason = std::move(pile);
     } else {
       verdict.reason = CheckPickWaypoints(verdict.box, workspace, waypoints, reachable);
     }
     verdict.accepted = verdict.reason.empty();
-    result.verdicts.push_back(std::move(verdict));
   }
 
   // Repeatedly the best of the rest: the highest grasp point, ties within

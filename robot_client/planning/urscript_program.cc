@@ -15,9 +15,11 @@ namespace {
 // The one template. Parameters (all substituted; units as in the header):
 //   ${name}                program name, also in the start/done messages
 //   ${tcp_offset}          flange -> TCP, pose literal (m, rad)
+//   ${approach_joints}     M, joint vector literal (rad): the planned IK solution
 //   ${approach}            M, pose literal, base frame (m, rad)
 //   ${grasp}               G, pose literal
 //   ${retrieve}            R, pose literal
+//   ${place_above_joints}  above F, joint vector literal (rad)
 //   ${place_above}         above F, pose literal
 //   ${place}               F, pose literal
 //   ${clear_joints}        clear pose, joint vector literal (rad)
@@ -32,12 +34,12 @@ namespace {
 constexpr absl::string_view kPickProgramTemplate = R"(def ${name}():
   set_tcp(${tcp_offset})
   textmsg("${name}: start")
-  movej(${approach}, a=${joint_acceleration}, v=${joint_speed})
+  movej(${approach_joints}, a=${joint_acceleration}, v=${joint_speed})
   movel(${grasp}, a=${linear_acceleration}, v=${linear_speed})
   ${suction_out}(${suction_index}, True)
   sleep(${grasp_settle})
   movel(${retrieve}, a=${linear_acceleration}, v=${linear_speed})
-  movej(${place_above}, a=${joint_acceleration}, v=${joint_speed})
+  movej(${place_above_joints}, a=${joint_acceleration}, v=${joint_speed})
   movel(${place}, a=${linear_acceleration}, v=${linear_speed})
   ${suction_out}(${suction_index}, False)
   sleep(${release})
@@ -98,8 +100,13 @@ absl::StatusOr<std::string> RenderPickProgram(absl::string_view name, const Pick
       return absl::InvalidArgumentError(absl::StrCat("pose ", what, " is not finite"));
     }
   }
-  for (double v : clear_joints) {
-    if (!std::isfinite(v)) return absl::InvalidArgumentError("clear joints are not finite");
+  for (const auto& [what, joints] :
+       {std::pair<const char*, const ur::Joints*>{"clear joints", &clear_joints},
+        {"approach joints", &plan.approach_joints},
+        {"place_above joints", &plan.place_above_joints}}) {
+    for (double v : *joints) {
+      if (!std::isfinite(v)) return absl::InvalidArgumentError(absl::StrCat(what, " are not finite"));
+    }
   }
   for (double v :
        {motion.joint_speed_rad_s, motion.joint_acceleration_rad_s2, motion.linear_speed_m_s,
@@ -112,6 +119,8 @@ absl::StatusOr<std::string> RenderPickProgram(absl::string_view name, const Pick
       {
           {"${name}", name},
           {"${tcp_offset}", pose(gripper.flange_T_tcp)},
+          {"${approach_joints}", ur::FormatJointsLiteral(plan.approach_joints)},
+          {"${place_above_joints}", ur::FormatJointsLiteral(plan.place_above_joints)},
           {"${approach}", pose(plan.approach)},
           {"${grasp}", pose(plan.grasp)},
           {"${retrieve}", pose(plan.retrieve)},

@@ -6,12 +6,13 @@
 //   def <name>():
 //     set_tcp(<tcp_offset>)              the suction cup tip, flange frame
 //     textmsg("<name>: start")
-//     movej(<M>, a=<ja>, v=<jv>)          approach I -> M, free move
+//     movej(<M joints>, a=<ja>, v=<jv>)   approach I -> M, free move in joint
+//                                         space to the planned IK solution
 //     movel(<G>, a=<la>, v=<lv>)          grasp, straight down onto the face
 //     <suction>(<index>, True)            vacuum on
 //     sleep(<grasp_settle_s>)
 //     movel(<R>, a=<la>, v=<lv>)          retrieve, straight up
-//     movej(<place_above>, a=<ja>, v=<jv>)
+//     movej(<place_above joints>, a=<ja>, v=<jv>)
 //     movel(<F>, a=<la>, v=<lv>)          lower onto the slot
 //     <suction>(<index>, False)           vacuum off
 //     sleep(<release_s>)
@@ -21,8 +22,10 @@
 //   end
 //
 // Poses are TCP poses in the base frame as literals p[x, y, z, rx, ry, rz]
-// (metres, rotation vector in radians; ur::FormatPoseLiteral); the clear pose
-// is a joint vector [q1, ..., q6] in radians. <suction> is
+// (metres, rotation vector in radians; ur::FormatPoseLiteral); the free-move
+// targets (PickPlan::approach_joints, place_above_joints: the planner's
+// choice of configuration branch) and the clear pose are joint vectors
+// [q1, ..., q6] in radians. <suction> is
 // set_tool_digital_out or set_standard_digital_out. Numbers are plain
 // decimals (no exponent). The text is ASCII, two-space indented, `def` and
 // `end` in column 1, ending in a newline.

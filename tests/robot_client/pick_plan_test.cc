@@ -297,10 +297,11 @@ TEST(StraightMoveTest, BadInputIsInvalidArgument) {
             absl::StatusCode::kInvalidArgument);
 }
 
-TEST_F(PickPlanTest, OrientationsWhoseStraightMovesFailAreSkipped) {
-  // A carton top 0.45 m up at (0, -0.322): lifting it 0.25 m with the tool's
-  // x along base x stretches the elbow out (the demo's failing retrieve);
-  // a quarter turn of the tool keeps the arm clear of that.
+TEST_F(PickPlanTest, ABoxOnlyAnotherBranchReachesIsRefused) {
+  // A carton top 0.45 m up at (0, -0.322), next to the base: lifting it 0.25 m
+  // with the tool's x along base x stretches the elbow out (the demo's failing
+  // retrieve); the other tool rotations, and the slot behind the robot, are
+  // reached only by flipping the arm's configuration, which free moves never do.
   const BoxInBase box = BoxToBase(FlatBox(Eigen::Vector3d(0.0, -0.322, 0.375), 0.0),
                                   Eigen::Isometry3d::Identity(), kCarton);
   // Tool x along base x, the arm in the emulator's start-up configuration.
@@ -325,22 +326,54 @@ TEST_F(PickPlanTest, OrientationsWhoseStraightMovesFailAreSkipped) {
                      .ok());
   }
   absl::StatusOr<PickPlan> plan = PlanPick(arm, box, kCarton, slot_, 0, waypoints_, workspace_);
+  ASSERT_EQ(plan.status().code(), absl::StatusCode::kFailedPrecondition) << plan.status();
+  EXPECT_THAT(plan.status().message(), HasSubstr("straight move G->R (retrieve)"));
+  EXPECT_THAT(plan.status().message(), HasSubstr("nor with any other tool rotation"));
+}
+
+// The branch of a joint vector as the planner tells them apart: the wrist in
+// front of the shoulder along the arm's heading, and the elbow's sign.
+std::pair<bool, bool> BranchOf(const ur::Joints& q) {
+  const ur::DhParameters& dh = ur::NominalDh(ur::ArmModel::kUr5e);
+  const double reach = -(dh.a[1] * std::cos(q[1]) + dh.a[2] * std::cos(q[1] + q[2]));
+  return {reach >= 0.0, std::remainder(q[2], 2.0 * M_PI) >= 0.0};
+}
+
+TEST_F(PickPlanTest, FreeMovesKeepTheReferenceBranchForASlotBehindTheRobot) {
+  // The box in front of the base, the slot behind it: the nearest IK
+  // solution for the slot from over the box reaches back over the shoulder;
+  // the planner turns the base instead, and sends the joints it chose.
+  const BoxInBase box = BoxToBase(FlatBox(Eigen::Vector3d(0.1, -0.5, 0.075), 0.0),
+                                  Eigen::Isometry3d::Identity(), kCarton);
+  PickArm arm = ArmAt(ToolDown(Eigen::Vector3d(0.0, -0.4, 0.45), 0.0));
+  arm.branch_reference = arm.joints;
+  const Eigen::Isometry3d behind = Pose(Eigen::Vector3d(0.1, 0.5, 0.0), Eigen::Matrix3d::Identity());
+  absl::StatusOr<PickPlan> plan = PlanPick(arm, box, kCarton, behind, 0, waypoints_, workspace_);
   ASSERT_TRUE(plan.ok()) << plan.status();
-  EXPECT_GT(plan->grasp_rotation_rad, 0.1);
-  // Its joints are the ones the controller reaches the waypoints with.
-  EXPECT_EQ(plan->initial_joints, arm.joints);
-  const std::pair<const ur::Joints*, const Eigen::Isometry3d*> at[] = {
-      {&plan->approach_joints, &plan->approach},
-      {&plan->grasp_joints, &plan->grasp},
-      {&plan->retrieve_joints, &plan->retrieve},
-      {&plan->place_above_joints, &plan->place_above},
-      {&plan->place_joints, &plan->place}};
-  for (const auto& [q, pose] : at) {
-    EXPECT_TRUE(TcpPoseFromJoints(arm.model, *q, arm.flange_T_tcp).isApprox(*pose, 1e-6));
-  }
-  EXPECT_TRUE(CheckStraightMove(arm.model, arm.flange_T_tcp, plan->grasp_joints, plan->grasp,
-                                plan->retrieve, StraightMoveOptions(), nullptr)
-                  .ok());
+  const std::pair<bool, bool> want = BranchOf(arm.joints);
+  EXPECT_EQ(BranchOf(plan->approach_joints), want);
+  EXPECT_EQ(BranchOf(plan->place_above_joints), want);
+  // The base turned about half a turn to face the slot, within the limits.
+  EXPECT_GT(std::abs(plan->place_above_joints[0] - plan->retrieve_joints[0]), 2.0);
+  for (double q : plan->place_above_joints) EXPECT_LE(std::abs(q), 2.0 * M_PI);
+  EXPECT_TRUE(TcpPoseFromJoints(arm.model, plan->place_above_joints, arm.flange_T_tcp)
+                  .isApprox(plan->place_above, 1e-6));
+}
+
+TEST_F(PickPlanTest, HeightsComeFromThePile) {
+  // A carton 0.15 m up, next to a pile 0.60 m high: M 5 cm above the pile's
+  // top, R with the held box's bottom 5 cm above it.
+  BoxInBase box = BoxToBase(FlatBox(Eigen::Vector3d(0.1, -0.5, 0.075), 0.0),
+                            Eigen::Isometry3d::Identity(), kCarton);
+  EXPECT_DOUBLE_EQ(ApproachDistance(box, waypoints_), waypoints_.approach_distance_m);
+  EXPECT_DOUBLE_EQ(RetrieveHeight(box, waypoints_), waypoints_.retrieve_height_m);
+  box.pile_top_z_m = 0.60;
+  EXPECT_NEAR(ApproachDistance(box, waypoints_), 0.60 + 0.05 - 0.15, 1e-9);
+  EXPECT_NEAR(RetrieveHeight(box, waypoints_), 0.60 + 0.05 + 0.15 - 0.15, 1e-9);
+  // The box itself the top: the configured minimums.
+  box.pile_top_z_m = 0.15;
+  EXPECT_DOUBLE_EQ(ApproachDistance(box, waypoints_), waypoints_.approach_distance_m);
+  EXPECT_DOUBLE_EQ(RetrieveHeight(box, waypoints_), waypoints_.retrieve_height_m);
 }
 
 TEST_F(PickPlanTest, EveryOrientationFailingIsRefusedNamingTheMove) {

@@ -48,7 +48,7 @@ TEST_F(PickSelectionTest, TiltedFaceIsRejected) {
   DetectedBox tilted = Box(0, -0.5, 0.15, 0.9);
   tilted.camera_T_box.linear() =
       Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  DetectedBox slight = Box(0.2, -0.5, 0.15, 0.5);
+  DetectedBox slight = Box(0.35, -0.5, 0.15, 0.5);
   slight.camera_T_box.linear() =
       Eigen::AngleAxisd(20.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
   const PickSelection s = Select({tilted, slight});
@@ -94,6 +94,9 @@ TEST_F(PickSelectionTest, LowScoreIsRejected) {
 }
 
 TEST_F(PickSelectionTest, TopmostFirstThenScore) {
+  // Layers 1 cm thick here, so E below is not in B's and C's layer (a layer
+  // of three takes its median top: ALayerOfThreeSharesItsMedianTop).
+  selection_.layer_tolerance_m = 0.01;
   // B is clearly the highest.
   EXPECT_EQ(Select({Box(0, -0.5, 0.15, 0.9), Box(0.2, -0.5, 0.30, 0.5)}).chosen, 1);
   // C is 5 mm above B: a tie, decided by C's higher score; D, 7 mm below C,
@@ -109,7 +112,7 @@ TEST_F(PickSelectionTest, TopmostFirstThenScore) {
   with_e.push_back(Box(0.2, -0.7, 0.285, 1.0));
   EXPECT_EQ(Select(with_e).chosen, 2);
   // Equal heights and scores: the first.
-  EXPECT_EQ(Select({Box(0, -0.5, 0.15, 0.7), Box(0.2, -0.5, 0.15, 0.7)}).chosen, 0);
+  EXPECT_EQ(Select({Box(0, -0.5, 0.15, 0.7), Box(0.35, -0.5, 0.15, 0.7)}).chosen, 0);
 }
 
 TEST_F(PickSelectionTest, RankedListsTheAcceptedBoxesBestFirst) {
@@ -151,6 +154,66 @@ TEST_F(PickSelectionTest, BoxesGoThroughTheHandEyeCalibration) {
   ASSERT_EQ(s.chosen, 0) << s.verdicts[0].reason;
   EXPECT_TRUE(s.verdicts[0].box.grasp_point.isApprox(Eigen::Vector3d(0.05, -0.5, 0.15), 1e-9));
   EXPECT_NEAR(s.verdicts[0].box.tilt_deg, 0.0, 1e-6);
+}
+
+}  // namespace
+}  // namespace cornerpose::robot_client
+
+namespace cornerpose::robot_client {
+namespace {
+
+TEST_F(PickSelectionTest, BoxesSharingSpaceInALayerAreDeclined) {
+  // Two cartons of one layer 0.20 m apart along their 0.30 m length: 0.10 m
+  // of overlap, so one is misplaced (a centre off along the length); both are
+  // declined. A third, clear of both, is picked.
+  const PickSelection s =
+      Select({Box(0.0, -0.5, 0.15, 0.9), Box(0.2, -0.5, 0.15, 0.9), Box(0.0, -0.25, 0.15, 0.5)});
+  ASSERT_EQ(s.verdicts.size(), 3u);
+  EXPECT_THAT(s.verdicts[0].reason, HasSubstr("overlaps box #1 of its layer by 0.100 m"));
+  EXPECT_THAT(s.verdicts[1].reason, HasSubstr("overlaps box #0"));
+  EXPECT_TRUE(s.verdicts[2].accepted) << s.verdicts[2].reason;
+  EXPECT_EQ(s.chosen, 2);
+  // A looser max_overlap_m lets them both through.
+  selection_.max_overlap_m = 0.11;
+  EXPECT_EQ(Select({Box(0.0, -0.5, 0.15, 0.9), Box(0.2, -0.5, 0.15, 0.9)}).ranked.size(), 2u);
+}
+
+TEST_F(PickSelectionTest, WrongFaceSizeInALayerIsDeclined) {
+  // Three cartons lying flat (+z up: 0.15 m deep) and one the detector took
+  // on its side (+y up: 0.20 m deep) with its top at the same height.
+  std::vector<DetectedBox> boxes = {Box(0.0, -0.5, 0.30, 0.9), Box(0.35, -0.5, 0.30, 0.9),
+                                    Box(0.0, -0.25, 0.30, 0.9)};
+  DetectedBox side;
+  side.camera_T_box.translation() = Eigen::Vector3d(0.35, -0.25, 0.30 - 0.10);
+  side.camera_T_box.linear() =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  side.grasp_face = BoxFace::kPlusY;
+  side.score = 0.99;
+  boxes.push_back(side);
+  const PickSelection s = Select(boxes);
+  ASSERT_EQ(s.verdicts.size(), 4u);
+  EXPECT_NEAR(s.verdicts[3].box.depth_m, 0.20, 1e-9);
+  EXPECT_THAT(s.verdicts[3].reason, HasSubstr("3 of the 4 boxes in view"));
+  EXPECT_THAT(s.verdicts[3].reason, HasSubstr("the wrong face size"));
+  EXPECT_EQ(s.ranked.size(), 3u);
+  // With the check off, it is the best box.
+  selection_.min_layer_for_face_check = 0;
+  EXPECT_EQ(Select(boxes).chosen, 3);
+}
+
+TEST_F(PickSelectionTest, ALayerOfThreeSharesItsMedianTop) {
+  // Tops 0.300, 0.305 and 0.288 (the sensor's depth steps): each grasp point
+  // at 0.300; a pair alone keeps its own.
+  const PickSelection s = Select(
+      {Box(0.0, -0.5, 0.300, 0.9), Box(0.35, -0.5, 0.305, 0.9), Box(0.0, -0.25, 0.288, 0.9)});
+  for (const BoxVerdict& v : s.verdicts) EXPECT_NEAR(v.box.grasp_point.z(), 0.300, 1e-9);
+  const PickSelection pair = Select({Box(0.0, -0.5, 0.300, 0.9), Box(0.35, -0.5, 0.305, 0.9)});
+  EXPECT_NEAR(pair.verdicts[1].box.grasp_point.z(), 0.305, 1e-9);
+}
+
+TEST_F(PickSelectionTest, EveryBoxCarriesThePileTop) {
+  const PickSelection s = Select({Box(0.0, -0.5, 0.15, 0.9), Box(0.35, -0.5, 0.45, 0.2)});
+  for (const BoxVerdict& v : s.verdicts) EXPECT_NEAR(v.box.pile_top_z_m, 0.45, 1e-9);
 }
 
 }  // namespace

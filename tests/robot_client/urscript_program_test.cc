@@ -31,6 +31,9 @@ PickPlan FixedPlan() {
   plan.retrieve = ToolDownAt(0.1, -0.5, 0.4);
   plan.place = ToolDownAt(-0.32, 0.4, 0.15);
   plan.place_above = ToolDownAt(-0.32, 0.4, 0.25);
+  // The free moves' targets: the planner's IK solutions for M and place_above.
+  plan.approach_joints = {-1.2, -1.6, 1.5, -1.5, -1.5708, 0.3};
+  plan.place_above_joints = {1.9, -1.4, 1.2, -1.4, -1.5708, 0.25};
   return plan;
 }
 
@@ -50,12 +53,12 @@ TEST(UrscriptProgramTest, FixedPlanRendersExactly) {
             R"(def pick_0001():
   set_tcp(p[0.000000, 0.000000, 0.100000, 0.000000, 0.000000, 0.000000])
   textmsg("pick_0001: start")
-  movej(p[0.100000, -0.500000, 0.250000, 3.141593, 0.000000, 0.000000], a=1.4, v=1.05)
+  movej([-1.200000, -1.600000, 1.500000, -1.500000, -1.570800, 0.300000], a=1.4, v=1.05)
   movel(p[0.100000, -0.500000, 0.150000, 3.141593, 0.000000, 0.000000], a=0.5, v=0.1)
   set_tool_digital_out(0, True)
   sleep(0.3)
   movel(p[0.100000, -0.500000, 0.400000, 3.141593, 0.000000, 0.000000], a=0.5, v=0.1)
-  movej(p[-0.320000, 0.400000, 0.250000, 3.141593, 0.000000, 0.000000], a=1.4, v=1.05)
+  movej([1.900000, -1.400000, 1.200000, -1.400000, -1.570800, 0.250000], a=1.4, v=1.05)
   movel(p[-0.320000, 0.400000, 0.150000, 3.141593, 0.000000, 0.000000], a=0.5, v=0.1)
   set_tool_digital_out(0, False)
   sleep(0.3)
@@ -164,13 +167,13 @@ TEST(UrscriptProgramTest, StructureAndPoseLiteralsParseBack) {
       EXPECT_NE(lines[k][2], ' ');
     }
 
-    // tcp_offset, M, G, R, place_above, F, place_above: in program order.
+    // tcp_offset, G, R, F, place_above: in program order (M and the first
+    // place_above are joint vectors).
     const std::vector<ur::UrPose> literals = PoseLiterals(*text);
-    ASSERT_EQ(literals.size(), 7u);
-    const Eigen::Isometry3d expected[] = {Gripper().flange_T_tcp, plan.approach,    plan.grasp,
-                                          plan.retrieve,          plan.place_above, plan.place,
-                                          plan.place_above};
-    for (size_t k = 0; k < 7; ++k) {
+    ASSERT_EQ(literals.size(), 5u);
+    const Eigen::Isometry3d expected[] = {Gripper().flange_T_tcp, plan.grasp, plan.retrieve,
+                                          plan.place, plan.place_above};
+    for (size_t k = 0; k < 5; ++k) {
       const Eigen::Isometry3d back = ur::FromUrPose(literals[k]);
       EXPECT_LE(literals[k].rotation.norm(), M_PI + 1e-6);
       EXPECT_LT(ur::RotationAngleBetween(Eigen::Quaterniond(back.linear()),

@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
@@ -54,7 +55,47 @@ absl::Status ReadIntrinsics(const std::string& directory, RecordedFrames& frames
   return absl::OkStatus();
 }
 
+bool IsDepthPng(const fs::path& path) {
+  const std::string name = absl::AsciiStrToLower(path.filename().string());
+  return absl::EndsWith(name, ".png") && !absl::EndsWith(name, ".color.png") &&
+         !absl::StartsWith(name, ".");
+}
+
 }  // namespace
+
+std::string NewestFramePath(const std::string& directory) {
+  std::error_code error;
+  std::string newest;
+  for (const fs::directory_entry& entry : fs::directory_iterator(directory, error)) {
+    if (IsDepthPng(entry.path()) && entry.path().string() > newest) newest = entry.path().string();
+  }
+  return newest;
+}
+
+absl::StatusOr<RecordedFrames> LoadNewestFrame(const std::string& directory) {
+  std::error_code error;
+  if (!fs::is_directory(directory, error)) {
+    return absl::NotFoundError(absl::StrCat("cannot read directory '", directory, "'"));
+  }
+  RecordedFrames frames;
+  if (absl::Status s = ReadIntrinsics(directory, frames); !s.ok()) return s;
+  const std::string file = NewestFramePath(directory);
+  if (file.empty()) {
+    return absl::NotFoundError(absl::StrCat("no *.png depth frame in '", directory, "' yet"));
+  }
+  int width = 0;
+  int height = 0;
+  absl::StatusOr<std::vector<uint16_t>> depth = ReadDepthPng(file, &width, &height);
+  if (!depth.ok()) return depth.status();
+  if (width != frames.width || height != frames.height) {
+    return absl::InvalidArgumentError(absl::StrCat(file, " is ", width, "x", height,
+                                                   ", intrinsics.txt says ", frames.width, "x",
+                                                   frames.height));
+  }
+  frames.max_depth_mm = *std::max_element(depth->begin(), depth->end());
+  frames.depth_mm.push_back(*std::move(depth));
+  return frames;
+}
 
 absl::StatusOr<RecordedFrames> LoadRecordedFrames(const std::string& directory) {
   std::error_code error;
@@ -65,7 +106,7 @@ absl::StatusOr<RecordedFrames> LoadRecordedFrames(const std::string& directory) 
   }
   std::vector<std::string> files;
   for (const fs::directory_entry& entry : it) {
-    if (absl::AsciiStrToLower(entry.path().extension().string()) == ".png") {
+    if (IsDepthPng(entry.path())) {
       files.push_back(entry.path().string());
     }
   }

@@ -33,4 +33,16 @@ struct RecordedFrames {
 // intrinsics' size.
 absl::StatusOr<RecordedFrames> LoadRecordedFrames(const std::string& directory);
 
+// Follow mode: a directory another program keeps writing frames into (the
+// simulated cell's camera, tests/support/cell_sim), each written under a
+// temporary name and renamed to NAME.png. The newest frame is the last
+// *.png in name order (`*.color.png` excluded).
+
+// The size and field of view from DIR/intrinsics.txt, and the newest frame
+// (depth_mm holds exactly one). NOT_FOUND when there is no frame yet.
+absl::StatusOr<RecordedFrames> LoadNewestFrame(const std::string& directory);
+
+// The path of the newest frame, "" when there is none.
+std::string NewestFramePath(const std::string& directory);
+
 }  // namespace cornerpose::virtual_camera

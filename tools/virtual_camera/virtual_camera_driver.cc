@@ -6,12 +6,17 @@
 // Device URIs:
 //   cornerpose://virtual                 frames from $CORNERPOSE_VIRTUAL_CAMERA_DIR
 //   cornerpose://virtual?dir=DIR&fps=N   frames from DIR (an absolute path)
+//   ...&follow=1                         follow mode: DIR is being written
+//                                        (the simulated cell's camera); each
+//                                        frame sent is the newest PNG there
 // fps defaults to $CORNERPOSE_VIRTUAL_CAMERA_FPS, else 30. When
 // CORNERPOSE_VIRTUAL_CAMERA_DIR is set, "cornerpose://virtual" is also listed
 // by OpenNI::enumerateDevices (so "any device" opens it); the query form is
 // opened on demand. The one depth stream is DEPTH_1_MM at the frames' size,
 // not mirrored, replaying the PNGs in file-name order and starting over after
-// the last, with the field of view from intrinsics.txt.
+// the last (follow mode: the newest PNG at each frame time, re-read only when
+// a newer one appears; writers rename finished files into place), with the
+// field of view from intrinsics.txt.
 #include <OniCProperties.h>
 #include <OniCTypes.h>
 
@@ -31,6 +36,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "common/io/png_io.h"
 #include "tools/virtual_camera/recorded_frames.h"
 
 // ONI_EXPORT_DRIVER uses XnLib's allocation macros, which Debian does not ship.
@@ -50,6 +56,7 @@ constexpr int kNominalMaxDepthMm = 10000;
 struct DeviceConfig {
   std::string directory;
   double fps = 30;
+  bool follow = false;
 };
 
 std::string Env(const char* name) {
@@ -74,9 +81,15 @@ absl::StatusOr<DeviceConfig> ParseUri(absl::string_view uri) {
         config.directory = kv.second;
       } else if (kv.first == "fps") {
         fps_text = kv.second;
+      } else if (kv.first == "follow") {
+        if (kv.second != "0" && kv.second != "1") {
+          return absl::InvalidArgumentError(
+              absl::StrCat("follow '", kv.second, "' must be 0 or 1 in '", uri, "'"));
+        }
+        config.follow = kv.second == "1";
       } else {
-        return absl::InvalidArgumentError(
-            absl::StrCat("unknown parameter '", kv.first, "' in '", uri, "' (dir, fps)"));
+        return absl::InvalidArgumentError(absl::StrCat("unknown parameter '", kv.first, "' in '",
+                                                       uri, "' (dir, fps, follow)"));
       }
     }
   }
@@ -93,8 +106,10 @@ absl::StatusOr<DeviceConfig> ParseUri(absl::string_view uri) {
 
 class DepthStream final : public oni::driver::StreamBase {
  public:
-  DepthStream(std::shared_ptr<const RecordedFrames> frames, double fps)
-      : frames_(std::move(frames)), fps_(fps) {
+  // follow_directory non-empty: follow mode (frames holds the first frame).
+  DepthStream(std::shared_ptr<const RecordedFrames> frames, double fps,
+              std::string follow_directory)
+      : frames_(std::move(frames)), fps_(fps), follow_directory_(std::move(follow_directory)) {
     mode_.pixelFormat = ONI_PIXEL_FORMAT_DEPTH_1_MM;
     mode_.resolutionX = frames_->width;
     mode_.resolutionY = frames_->height;
@@ -191,12 +206,29 @@ class DepthStream final : public oni::driver::StreamBase {
     return ONI_STATUS_OK;
   }
 
+  // Follow mode: the newest frame in the directory, re-read when it changed;
+  // a file that does not load (wrong size, removed meanwhile) keeps the last.
+  const std::vector<uint16_t>& Newest() {
+    const std::string path = NewestFramePath(follow_directory_);
+    if (!path.empty() && path != live_path_) {
+      int width = 0;
+      int height = 0;
+      absl::StatusOr<std::vector<uint16_t>> depth = ReadDepthPng(path, &width, &height);
+      if (depth.ok() && width == frames_->width && height == frames_->height) {
+        live_ = *std::move(depth);
+        live_path_ = path;
+      }
+    }
+    return live_.empty() ? frames_->depth_mm[0] : live_;
+  }
+
   // Sends frame i % count at start + i / fps; timestamps (microseconds) are
   // i / fps exactly, so recordings replay at the set rate.
   void Run() {
     const auto start = std::chrono::steady_clock::now();
     const size_t count = frames_->depth_mm.size();
     const size_t bytes = frames_->depth_mm[0].size() * sizeof(OniDepthPixel);
+    const bool follow = !follow_directory_.empty();
     for (uint64_t i = 0;; ++i) {
       const auto due = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                    std::chrono::duration<double>(i / fps_));
@@ -210,7 +242,8 @@ class DepthStream final : public oni::driver::StreamBase {
         getServices().releaseFrame(frame);
         continue;
       }
-      std::memcpy(frame->data, frames_->depth_mm[i % count].data(), bytes);
+      const std::vector<uint16_t>& depth = follow ? Newest() : frames_->depth_mm[i % count];
+      std::memcpy(frame->data, depth.data(), bytes);
       frame->dataSize = static_cast<int>(bytes);
       frame->sensorType = ONI_SENSOR_DEPTH;
       frame->timestamp = static_cast<uint64_t>(i * 1e6 / fps_);
@@ -229,6 +262,9 @@ class DepthStream final : public oni::driver::StreamBase {
 
   const std::shared_ptr<const RecordedFrames> frames_;
   const double fps_;
+  const std::string follow_directory_;
+  std::vector<uint16_t> live_;  // follow mode, the stream thread's only
+  std::string live_path_;
   OniVideoMode mode_{};
 
   std::mutex mutex_;
@@ -239,8 +275,8 @@ class DepthStream final : public oni::driver::StreamBase {
 
 class Device final : public oni::driver::DeviceBase {
  public:
-  Device(std::shared_ptr<const RecordedFrames> frames, double fps)
-      : frames_(std::move(frames)), fps_(fps) {
+  Device(std::shared_ptr<const RecordedFrames> frames, double fps, std::string follow_directory)
+      : frames_(std::move(frames)), fps_(fps), follow_directory_(std::move(follow_directory)) {
     mode_.pixelFormat = ONI_PIXEL_FORMAT_DEPTH_1_MM;
     mode_.resolutionX = frames_->width;
     mode_.resolutionY = frames_->height;
@@ -258,7 +294,7 @@ class Device final : public oni::driver::DeviceBase {
 
   oni::driver::StreamBase* createStream(OniSensorType type) override {
     if (type != ONI_SENSOR_DEPTH) return nullptr;
-    return new DepthStream(frames_, fps_);
+    return new DepthStream(frames_, fps_, follow_directory_);
   }
 
   void destroyStream(oni::driver::StreamBase* stream) override { delete stream; }
@@ -266,6 +302,7 @@ class Device final : public oni::driver::DeviceBase {
  private:
   const std::shared_ptr<const RecordedFrames> frames_;
   const double fps_;
+  const std::string follow_directory_;
   OniVideoMode mode_{};
   OniSensorInfo sensor_{};
 };
@@ -307,13 +344,18 @@ class Driver final : public oni::driver::DriverBase {
       getServices().errorLoggerAppend("%s", std::string(config.status().message()).c_str());
       return nullptr;
     }
-    absl::StatusOr<RecordedFrames> frames = LoadRecordedFrames(config->directory);
+    absl::StatusOr<RecordedFrames> frames = config->follow
+                                                ? LoadNewestFrame(config->directory)
+                                                : LoadRecordedFrames(config->directory);
     if (!frames.ok()) {
       getServices().errorLoggerAppend("cornerpose virtual camera: %s",
                                       std::string(frames.status().message()).c_str());
       return nullptr;
     }
-    return new Device(std::make_shared<const RecordedFrames>(*std::move(frames)), config->fps);
+    // A followed directory's depths grow as the scene changes: report at
+    // least the nominal maximum (MAX_VALUE uses it).
+    return new Device(std::make_shared<const RecordedFrames>(*std::move(frames)), config->fps,
+                      config->follow ? config->directory : "");
   }
 
   void deviceClose(oni::driver::DeviceBase* device) override { delete device; }

@@ -141,6 +141,18 @@ Eigen::Isometry3d Controller::TcpOf(const ur::Joints& q) const {
   return ur::ForwardKinematics(options_.model, q) * tcp_offset_;
 }
 
+ArmState Controller::ArmStateLocked() const {
+  ArmState state;
+  state.time_s = SimTimeLocked();
+  state.joints = q_;
+  state.base_T_tcp = TcpOf(q_);
+  state.flange_T_tcp = tcp_offset_;
+  state.tool_outputs = tool_outputs_;
+  state.standard_outputs = standard_outputs_;
+  if (program_running_) state.program = programs_[current_program_].name;
+  return state;
+}
+
 void Controller::EmitLocked(ControllerEvent event) {
   event.time_s = SimTimeLocked();
   events_.push_back(std::move(event));
@@ -451,6 +463,7 @@ void Controller::RunProgramLocked(std::unique_lock<std::mutex>& lock, Pending pe
   programs_.push_back(std::move(record));
   current_program_ = programs_.size() - 1;
   program_running_ = true;
+  if (options_.world) options_.world->OnProgramStart(pending.program.name, SimTimeLocked());
   {
     ControllerEvent event;
     event.kind = ControllerEvent::Kind::kProgramStarted;
@@ -483,6 +496,15 @@ void Controller::RunProgramLocked(std::unique_lock<std::mutex>& lock, Pending pe
   done.error_line = outcome.line;
   done.error_column = outcome.column;
   done.end_time_s = SimTimeLocked();
+  const std::string name = done.name;  // programs_ may grow while unlocked
+  const double end_time_s = done.end_time_s;
+  if (options_.world) {
+    // Without the lock: the world may wait for its camera.
+    lock.unlock();
+    options_.world->OnProgramEnd(name, outcome.outcome == ProgramOutcome::kCompleted,
+                                 end_time_s);
+    lock.lock();
+  }
   program_running_ = false;
   ++programs_finished_;
   qd_ = {};
@@ -497,7 +519,7 @@ void Controller::RunProgramLocked(std::unique_lock<std::mutex>& lock, Pending pe
   }
   ControllerEvent stopped;
   stopped.kind = ControllerEvent::Kind::kProgramStopped;
-  stopped.text = done.name;
+  stopped.text = name;
   EmitLocked(std::move(stopped));
   if (abort_ != Abort::kShutdown) abort_ = Abort::kNone;
   changed_.notify_all();
@@ -536,6 +558,20 @@ std::optional<Controller::Outcome> Controller::MoveLocked(
     for (int i = 0; i < 6; ++i) qd_[i] = (q[i] - q_[i]) / dt;
     q_ = q;
     changed_.notify_all();
+    if (options_.world) {
+      if (std::optional<std::string> contact = options_.world->OnStep(ArmStateLocked())) {
+        // A collision: the arm stops where it touched, as a real arm's
+        // collision detection stops it (protective stop).
+        step.completed = false;
+        RecordStepLocked(std::move(step));
+        ControllerEvent event;
+        event.kind = ControllerEvent::Kind::kText;
+        event.text = absl::StrCat("protective stop: collision: ", *contact);
+        EmitLocked(std::move(event));
+        TriggerProtectiveStopLocked();
+        return AbortOutcomeLocked();
+      }
+    }
     if (t >= duration) break;
   }
   qd_ = {};
@@ -657,6 +693,7 @@ std::optional<Controller::Outcome> Controller::ExecuteLocked(std::unique_lock<st
     } else {
       *bits &= ~(1u << n);
     }
+    if (options_.world) options_.world->OnOutputs(ArmStateLocked());
     changed_.notify_all();
     RecordStepLocked(std::move(step));
     return std::nullopt;

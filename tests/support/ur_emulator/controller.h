@@ -197,6 +197,7 @@ class Controller {
   double SimTimeLocked() const;
   std::chrono::steady_clock::time_point WallOf(double sim_time) const;
   Eigen::Isometry3d TcpOf(const ur::Joints& q) const;
+  ArmState ArmStateLocked() const;
 
   const UrEmulatorOptions options_;
   const std::chrono::steady_clock::time_point start_;

@@ -1,10 +1,12 @@
 // Options of the UR controller emulator (tests/support/ur_emulator).
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "robot_client/ur/kinematics.h"
 #include "robot_client/ur/pose.h"
+#include "tests/support/ur_emulator/arm_world.h"
 
 namespace cornerpose::ur_emulator {
 
@@ -59,6 +61,10 @@ struct UrEmulatorOptions {
   int version_minor = 11;
   int version_bugfix = 1;
   int version_build = 108318;
+
+  // The simulated cell the arm acts on (suction, carried boxes, collisions);
+  // null: free space. Shared so a test can keep reading it.
+  std::shared_ptr<ArmWorld> world;
 };
 
 }  // namespace cornerpose::ur_emulator
