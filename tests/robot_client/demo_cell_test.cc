@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "common/perception/types.h"  // the camera model of the view check
 #include "robot_client/config/robot_config.h"
 #include "robot_client/planning/grasp_geometry.h"
 #include "robot_client/planning/pick_plan.h"
