@@ -73,6 +73,12 @@ double RetrieveHeight(const BoxInBase& box, const WaypointOptions& waypoints) {
                                                    box.depth_m - box.grasp_point.z());
 }
 
+double PlaceApproachHeight(const BoxInBase& box, const WaypointOptions& waypoints) {
+  // The boxes already in the slot's layer are as tall as this one placed
+  // grasp face up: the free move must bring its bottom in above their tops.
+  return std::max(waypoints.place_approach_height_m, box.depth_m + waypoints.pile_clearance_m);
+}
+
 namespace {
 
 // The waypoints of one choice of grasp and place orientation.
@@ -91,7 +97,7 @@ PickPlan Waypoints(const Eigen::Isometry3d& initial, const BoxInBase& box,
   plan.tcp_T_box = grasp.inverse() * box.base_T_box;
   plan.base_T_box_placed = base_T_slot * slot_T_box;
   plan.place = plan.base_T_box_placed * plan.tcp_T_box.inverse();
-  plan.place_above = RaisedAlongBaseZ(plan.place, waypoints.place_approach_height_m);
+  plan.place_above = RaisedAlongBaseZ(plan.place, PlaceApproachHeight(box, waypoints));
   plan.grasp_rotation_rad = RotationBetween(initial, grasp);
   plan.place_rotation_rad = RotationBetween(grasp, plan.place);
   return plan;

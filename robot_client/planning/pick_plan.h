@@ -110,6 +110,10 @@ absl::StatusOr<PickPlan> PlanPick(const PickArm& arm, const BoxInBase& box, cons
 // the pile's top, R with the held box's bottom pile_clearance_m above it.
 double ApproachDistance(const BoxInBase& box, const WaypointOptions& waypoints);
 double RetrieveHeight(const BoxInBase& box, const WaypointOptions& waypoints);
+// a in place_above = F + a z: place_approach_height_m, raised so the held
+// box's bottom arrives pile_clearance_m above the tops of the boxes already
+// in its layer (depth_m tall, placed as it will be).
+double PlaceApproachHeight(const BoxInBase& box, const WaypointOptions& waypoints);
 
 // The daemon's entry point: PlanPick with the configured arm model, the
 // gripper's TCP offset, `current_joints`, the clear pose as the branch

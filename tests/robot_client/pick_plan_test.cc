@@ -150,9 +150,10 @@ TEST_F(PickPlanTest, WaypointsFollowThePaper) {
   EXPECT_TRUE(plan->retrieve.linear().isApprox(plan->grasp.linear(), kTol));
   // Tool z antiparallel to the face's outward normal.
   EXPECT_NEAR(plan->grasp.linear().col(2).dot(box.grasp_normal), -1.0, kTol);
-  // place_above = F + a z.
+  // place_above = F + a z, a = 0.15 (the carton's height) + 5 cm clearance
+  // over the boxes already in its layer.
   EXPECT_TRUE((plan->place_above.translation() - plan->place.translation())
-                  .isApprox(Eigen::Vector3d(0, 0, 0.10), kTol));
+                  .isApprox(Eigen::Vector3d(0, 0, 0.20), kTol));
   EXPECT_TRUE(plan->place_above.linear().isApprox(plan->place.linear(), kTol));
   // The held box goes with the tool, and its bottom centre lands on the slot.
   EXPECT_TRUE((plan->place * plan->tcp_T_box).isApprox(plan->base_T_box_placed, kTol));
@@ -370,6 +371,8 @@ TEST_F(PickPlanTest, HeightsComeFromThePile) {
   box.pile_top_z_m = 0.60;
   EXPECT_NEAR(ApproachDistance(box, waypoints_), 0.60 + 0.05 - 0.15, 1e-9);
   EXPECT_NEAR(RetrieveHeight(box, waypoints_), 0.60 + 0.05 + 0.15 - 0.15, 1e-9);
+  // Above the slot: the held box's bottom 5 cm above its layer's tops.
+  EXPECT_NEAR(PlaceApproachHeight(box, waypoints_), 0.15 + 0.05, 1e-9);
   // The box itself the top: the configured minimums.
   box.pile_top_z_m = 0.15;
   EXPECT_DOUBLE_EQ(ApproachDistance(box, waypoints_), waypoints_.approach_distance_m);

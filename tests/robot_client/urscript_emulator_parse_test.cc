@@ -46,13 +46,22 @@ TEST(UrscriptEmulatorParseTest, EmulatorCompilesTheProgramAsPlanned) {
     for (size_t i = 0; i < expected.size(); ++i) {
       EXPECT_EQ(parsed.program.calls[i].function, expected[i]) << i;
     }
-    // Pose targets, in order: M, G, R, place_above, F, place_above.
-    const Eigen::Isometry3d* targets[] = {&plan.approach,    &plan.grasp, &plan.retrieve,
-                                          &plan.place_above, &plan.place, &plan.place_above};
-    const size_t moves[] = {2, 3, 6, 7, 8, 11};
-    for (size_t k = 0; k < 6; ++k) {
+    // The free moves' targets are the planned joints: M's, place_above's.
+    const std::pair<size_t, const ur::Joints*> joint_moves[] = {{2, &plan.approach_joints},
+                                                                {7, &plan.place_above_joints}};
+    for (const auto& [index, joints] : joint_moves) {
+      const ur_emulator::ScriptValue& q = parsed.program.calls[index].arg("q");
+      ASSERT_EQ(q.kind, ur_emulator::ScriptValue::Kind::kList) << index;
+      ASSERT_EQ(q.elements.size(), 6u);
+      for (size_t i = 0; i < 6; ++i) EXPECT_NEAR(q.elements[i], (*joints)[i], 1e-6) << index;
+    }
+    // Pose targets, in order: G, R, F, place_above.
+    const Eigen::Isometry3d* targets[] = {&plan.grasp, &plan.retrieve, &plan.place,
+                                          &plan.place_above};
+    const size_t moves[] = {3, 6, 8, 11};
+    for (size_t k = 0; k < 4; ++k) {
       const ur_emulator::ScriptCall& call = parsed.program.calls[moves[k]];
-      const ur_emulator::ScriptValue& target = call.arg(call.function == "movej" ? "q" : "pose");
+      const ur_emulator::ScriptValue& target = call.arg("pose");
       ASSERT_EQ(target.kind, ur_emulator::ScriptValue::Kind::kPose) << k;
       ASSERT_EQ(target.elements.size(), 6u);
       const ur::UrPose pose{
