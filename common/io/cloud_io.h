@@ -1,5 +1,5 @@
-// Loading and saving point clouds: PCD and PLY through PCL, 16-bit depth PNGs
-// through libpng. No PCL types cross this header.
+// Loading and saving point clouds: PCD through our reader (pcd_reader.h), PLY
+// through PCL, 16-bit depth PNGs through libpng. No PCL types cross this header.
 #pragma once
 
 #include <Eigen/Core>
