@@ -6,6 +6,8 @@
 // never used.
 #pragma once
 
+#include <grpcpp/security/credentials.h>
+
 #include <condition_variable>
 #include <cstdint>
 #include <memory>
@@ -37,6 +39,11 @@ struct PerceptionSubscriberOptions {
   // doubles per failed attempt up to `max`, resets once a frame arrives.
   absl::Duration initial_backoff = absl::Milliseconds(200);
   absl::Duration max_backoff = absl::Seconds(5);
+  // The channel's credentials (MakeChannelCredentials, common/grpc_security);
+  // null = plaintext. tls_server_name, when set, is the name the server's
+  // certificate must carry.
+  std::shared_ptr<grpc::ChannelCredentials> credentials;
+  std::string tls_server_name;
 };
 
 // One frame's detected boxes and where they came from.
