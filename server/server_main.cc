@@ -196,10 +196,12 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::cerr << "cornerpose_server: listening on " << options.listen_address << " (port "
-            << (*server)->port() << ", "
+            << (*server)->port() << ")" << std::endl;
+  // A line of its own: scripts and tests match the one above.
+  std::cerr << "cornerpose_server: "
             << (options.tls_client_ca.empty() ? (options.tls_cert.empty() ? "plaintext" : "TLS")
                                               : "mutual TLS")
-            << (options.enable_reflection ? ", reflection on" : "") << ")" << std::endl;
+            << (options.enable_reflection ? ", reflection on" : ", reflection off") << std::endl;
   if (const std::string warning = cornerpose::PlaintextWarning(
           "cornerpose_server", options.listen_address, !options.tls_cert.empty());
       !warning.empty()) {
