@@ -26,6 +26,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
 #include "absl/strings/strip.h"
+#include "common/grpc_security/tls.h"
 #include "common/logging/log.h"
 #include "server/config/server_config.h"
 #include "server/config/server_options.h"
@@ -53,6 +54,24 @@ ABSL_FLAG(std::string, cell_status_address, "",
 ABSL_FLAG(std::string, view_box, cornerpose::server::HttpOptions{}.view_box,
           "the box the web view detects when the page names none (model name or L,B,H)");
 ABSL_FLAG(std::string, log_format, "text", "log lines as text or json (one object per line)");
+ABSL_FLAG(int, max_queued_detections, cornerpose::server::ServerOptions{}.max_queued_detections,
+          "Detect requests that may wait for a worker; one more is RESOURCE_EXHAUSTED");
+ABSL_FLAG(int, max_streams, cornerpose::server::ServerOptions{}.max_streams,
+          "StreamDetections calls open at once; one more is RESOURCE_EXHAUSTED");
+ABSL_FLAG(int, default_deadline_ms, cornerpose::server::ServerOptions{}.default_deadline_ms,
+          "deadline of a Detect that brings none, ms");
+ABSL_FLAG(int, max_deadline_ms, cornerpose::server::ServerOptions{}.max_deadline_ms,
+          "longest a Detect may take whatever its deadline, ms");
+ABSL_FLAG(int, shutdown_grace_ms, cornerpose::server::ServerOptions{}.shutdown_grace_ms,
+          "on SIGTERM, how long RPCs in flight may finish before they are cancelled, ms");
+ABSL_FLAG(int, stall_timeout_ms, cornerpose::server::ServerOptions{}.stall_timeout_ms,
+          "health is NOT_SERVING while detections wait and none finished for this long, ms");
+ABSL_FLAG(std::string, tls_cert, "", "PEM certificate (chain) of the server; with --tls_key: TLS");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
+ABSL_FLAG(std::string, tls_client_ca, "",
+          "PEM CA bundle; when set, clients must present a certificate it signed (mutual TLS)");
+ABSL_FLAG(bool, reflection, cornerpose::server::ServerOptions{}.enable_reflection,
+          "serve gRPC reflection (off in production)");
 ABSL_FLAG(std::vector<std::string>, source, {},
           "a frame source: NAME=DIR[:FPS[:loop|once]] (recorded frames, default 5 fps, loop), "
           "NAME=openni2:[URI] (an OpenNI2 camera; empty URI = any), or "
@@ -171,6 +190,21 @@ int main(int argc, char** argv) {
     options.http.cell_status_address = absl::GetFlag(FLAGS_cell_status_address);
   }
   if (given("view_box")) options.http.view_box = absl::GetFlag(FLAGS_view_box);
+  const auto take_int = [&](absl::string_view name, const absl::Flag<int>& flag, int* out) {
+    if (given(name)) *out = absl::GetFlag(flag);
+  };
+  take_int("max_queued_detections", FLAGS_max_queued_detections, &options.max_queued_detections);
+  take_int("max_streams", FLAGS_max_streams, &options.max_streams);
+  take_int("default_deadline_ms", FLAGS_default_deadline_ms, &options.default_deadline_ms);
+  take_int("max_deadline_ms", FLAGS_max_deadline_ms, &options.max_deadline_ms);
+  take_int("shutdown_grace_ms", FLAGS_shutdown_grace_ms, &options.shutdown_grace_ms);
+  take_int("stall_timeout_ms", FLAGS_stall_timeout_ms, &options.stall_timeout_ms);
+  if (given("tls_cert")) options.tls_cert = absl::GetFlag(FLAGS_tls_cert);
+  if (given("tls_key")) options.tls_key = absl::GetFlag(FLAGS_tls_key);
+  if (given("tls_client_ca")) options.tls_client_ca = absl::GetFlag(FLAGS_tls_client_ca);
+  if (given("reflection") || SpecifiedOnCommandLine(argc, argv, "noreflection")) {
+    options.enable_reflection = absl::GetFlag(FLAGS_reflection);
+  }
   if (!source_flags.empty()) options.sources.clear();
   for (const std::string& text : source_flags) {
     absl::StatusOr<cornerpose::server::SourceSpec> spec = cornerpose::server::ParseSourceSpec(text);
@@ -196,6 +230,21 @@ int main(int argc, char** argv) {
                  {{"name", spec.name},
                   {"where", spec.kind == cornerpose::server::SourceKind::kDirectory ? spec.directory
                                                                                   : spec.uri}});
+  }
+  // A line of its own: scripts and tests match the one above.
+  logging::Log(logging::LogLevel::kInfo, "server",
+               absl::StrCat(options.tls_client_ca.empty()
+                                ? (options.tls_cert.empty() ? "plaintext" : "TLS")
+                                : "mutual TLS",
+                            options.enable_reflection ? ", reflection on" : ", reflection off"),
+               {{"tls", options.tls_client_ca.empty()
+                            ? (options.tls_cert.empty() ? "plaintext" : "tls")
+                            : "mutual_tls"},
+                {"reflection", options.enable_reflection}});
+  if (const std::string warning = cornerpose::PlaintextWarning(
+          "cornerpose_server", options.listen_address, !options.tls_cert.empty());
+      !warning.empty()) {
+    logging::Log(logging::LogLevel::kWarning, "server", warning);
   }
 
   while (sem_wait(&stop_requested) != 0 && errno == EINTR) {

@@ -94,8 +94,13 @@ void PerceptionSubscriber::Run() {
   // Reconnect quickly when the service comes back.
   channel_args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS,
                       static_cast<int>(absl::ToInt64Milliseconds(options_.max_backoff)));
-  std::shared_ptr<grpc::Channel> channel =
-      grpc::CreateCustomChannel(options_.server, grpc::InsecureChannelCredentials(), channel_args);
+  if (!options_.tls_server_name.empty()) {
+    channel_args.SetSslTargetNameOverride(options_.tls_server_name);
+  }
+  std::shared_ptr<grpc::Channel> channel = grpc::CreateCustomChannel(
+      options_.server,
+      options_.credentials != nullptr ? options_.credentials : grpc::InsecureChannelCredentials(),
+      channel_args);
   std::unique_ptr<v1::PerceptionService::Stub> stub = v1::PerceptionService::NewStub(channel);
 
   v1::StreamDetectionsRequest request;

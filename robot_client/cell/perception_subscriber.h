@@ -6,6 +6,8 @@
 // never used.
 #pragma once
 
+#include <grpcpp/security/credentials.h>
+
 #include <condition_variable>
 #include <cstdint>
 #include <memory>
@@ -40,6 +42,11 @@ struct PerceptionSubscriberOptions {
   // A detection received longer ago than this (this machine's clock) is
   // not used: the stream has stalled.
   absl::Duration max_frame_age = absl::Seconds(2);
+  // The channel's credentials (MakeChannelCredentials, common/grpc_security);
+  // null = plaintext. tls_server_name, when set, is the name the server's
+  // certificate must carry.
+  std::shared_ptr<grpc::ChannelCredentials> credentials;
+  std::string tls_server_name;
 };
 
 // One frame's detected boxes and where they came from.

@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
@@ -26,6 +27,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "common/grpc_security/tls.h"
 #include "common/logging/log.h"
 #include "common/metrics/metrics_http.h"
 #include "robot_client/cell/cell_controller.h"
@@ -45,6 +47,15 @@ ABSL_FLAG(int, primary_port, 0, "the controller's primary interface port (overri
 ABSL_FLAG(int, rtde_port, 0, "the controller's RTDE port (overrides the file)");
 ABSL_FLAG(std::string, status_listen, "",
           "host:port of the status service (overrides the file; port 0 picks one)");
+ABSL_FLAG(std::string, tls_ca, "", "PEM CA of the perception service's certificate (TLS)");
+ABSL_FLAG(std::string, tls_cert, "", "PEM client certificate for the perception service");
+ABSL_FLAG(std::string, tls_key, "", "private key of --tls_cert");
+ABSL_FLAG(std::string, tls_server_name, "",
+          "name the perception service's certificate must carry (default: its host)");
+ABSL_FLAG(std::string, status_tls_cert, "", "PEM certificate of the status service (TLS)");
+ABSL_FLAG(std::string, status_tls_key, "", "private key of --status_tls_cert");
+ABSL_FLAG(std::string, status_tls_client_ca, "",
+          "PEM CA; when set, status clients must present a certificate it signed");
 ABSL_FLAG(bool, dry_run, false, "print the programs instead of sending them");
 ABSL_FLAG(int, max_picks, -1, "stop after this many picks (overrides the file; 0 = no limit)");
 ABSL_FLAG(std::string, metrics_listen, "127.0.0.1:9108",
@@ -117,6 +128,15 @@ int main(int argc, char** argv) {
   if (const std::string v = absl::GetFlag(FLAGS_status_listen); !v.empty()) {
     options.status_listen_address = v;
   }
+  for (auto [flag, field] : {std::pair{&FLAGS_tls_ca, &options.perception.tls_ca},
+                             std::pair{&FLAGS_tls_cert, &options.perception.tls_cert},
+                             std::pair{&FLAGS_tls_key, &options.perception.tls_key},
+                             std::pair{&FLAGS_tls_server_name, &options.perception.tls_server_name},
+                             std::pair{&FLAGS_status_tls_cert, &options.status_tls_cert},
+                             std::pair{&FLAGS_status_tls_key, &options.status_tls_key},
+                             std::pair{&FLAGS_status_tls_client_ca, &options.status_tls_client_ca}}) {
+    if (std::string v = absl::GetFlag(*flag); !v.empty()) *field = std::move(v);
+  }
   if (absl::GetFlag(FLAGS_dry_run)) options.dry_run = true;
   if (const int v = absl::GetFlag(FLAGS_max_picks); v >= 0) options.max_picks = v;
   if (absl::Status s = options.Validate(); !s.ok()) return Fail(s.ToString());
@@ -137,6 +157,18 @@ int main(int argc, char** argv) {
   perception.box = options.perception.box;
   perception.initial_backoff = absl::Seconds(options.perception.reconnect_initial_s);
   perception.max_backoff = absl::Seconds(options.perception.reconnect_max_s);
+  absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> credentials =
+      cornerpose::MakeChannelCredentials({.ca = options.perception.tls_ca,
+                                          .cert = options.perception.tls_cert,
+                                          .key = options.perception.tls_key},
+                                         nullptr);
+  if (!credentials.ok()) {
+    std::fprintf(stderr, "cornerpose_robot_client: perception: %s\n",
+                 credentials.status().ToString().c_str());
+    return 1;
+  }
+  perception.credentials = *std::move(credentials);
+  perception.tls_server_name = options.perception.tls_server_name;
   PerceptionSubscriber subscriber(perception);
 
   // Set once the cell exists (its status feeds the sampler).
@@ -181,6 +213,9 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   };
   const std::string status_address = options.status_listen_address;
+  const cornerpose::ServerTlsFiles status_tls = {.cert = options.status_tls_cert,
+                                                 .key = options.status_tls_key,
+                                                 .client_ca = options.status_tls_client_ca};
   Note(absl::StrCat("cornerpose_robot_client: perception ", options.perception.server_address,
                     " source '", options.perception.source, "', robot ", options.robot.host, " (",
                     dry_run ? "dry run" : "live", "), ", status_address),
@@ -191,9 +226,16 @@ int main(int argc, char** argv) {
         {"status_listen", status_address}});
   CellController cell(std::move(options), CellControllerOptions{}, &subscriber, callbacks);
 
-  absl::StatusOr<std::unique_ptr<StatusServer>> status = StartStatusServer(status_address, &cell);
+  absl::StatusOr<std::unique_ptr<StatusServer>> status = StartStatusServer(status_address, &cell, status_tls);
   if (!status.ok()) return Fail(status.status().ToString());
-  Note(absl::StrCat("status service on port ", (*status)->port()), {{"port", (*status)->port()}});
+  Note(absl::StrCat("status service on port ", (*status)->port(), " (",
+                    status_tls.enabled() ? "TLS" : "plaintext", ")"),
+       {{"port", (*status)->port()}, {"tls", status_tls.enabled()}});
+  if (const std::string warning = cornerpose::PlaintextWarning(
+          "the status service", status_address, status_tls.enabled());
+      !warning.empty()) {
+    std::fprintf(stderr, "cornerpose_robot_client: %s\n", warning.c_str());
+  }
 
   metrics = std::make_unique<DaemonMetrics>([&cell, &subscriber] {
     return DaemonMetrics::Sample{cell.Status(), subscriber.frames_received()};

@@ -1,12 +1,12 @@
 #include "robot_client/cell/status_service.h"
 
-#include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
 
 #include <chrono>
 
 #include "absl/strings/str_cat.h"
+#include "common/grpc_security/reflection.h"
 
 namespace cornerpose::robot_client {
 namespace {
@@ -151,13 +151,17 @@ void StatusServer::Shutdown() {
 }
 
 absl::StatusOr<std::unique_ptr<StatusServer>> StartStatusServer(const std::string& listen_address,
-                                                                CellController* cell) {
+                                                                CellController* cell,
+                                                                const ServerTlsFiles& tls) {
+  absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials = MakeServerCredentials(tls);
+  if (!credentials.ok()) return credentials.status();
   grpc::EnableDefaultHealthCheckService(true);
-  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   auto out = std::unique_ptr<StatusServer>(new StatusServer());
   out->service_ = std::make_unique<StatusServiceImpl>(cell);
   grpc::ServerBuilder builder;
-  builder.AddListeningPort(listen_address, grpc::InsecureServerCredentials(), &out->port_);
+  // Reflection only where nobody else can reach it in plaintext.
+  ConfigureReflection(builder, IsLoopbackAddress(listen_address) || tls.enabled());
+  builder.AddListeningPort(listen_address, *credentials, &out->port_);
   builder.RegisterService(out->service_.get());
   out->server_ = builder.BuildAndStart();
   if (!out->server_ || out->port_ == 0) {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "common/grpc_security/tls.h"
 #include "cornerpose/v1/robot_client_service.grpc.pb.h"
 #include "robot_client/cell/cell_controller.h"
 
@@ -46,15 +47,18 @@ class StatusServer {
 
  private:
   friend absl::StatusOr<std::unique_ptr<StatusServer>> StartStatusServer(
-      const std::string& listen_address, CellController* cell);
+      const std::string& listen_address, CellController* cell, const ServerTlsFiles& tls);
   std::unique_ptr<StatusServiceImpl> service_;
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
 };
 
-// Listens on `listen_address` (host:port; port 0 picks one). UNAVAILABLE
-// when the address cannot be bound.
+// Listens on `listen_address` (host:port; port 0 picks one), with TLS when
+// tls.cert is set (client certificates required when tls.client_ca is).
+// UNAVAILABLE when the address cannot be bound; INVALID_ARGUMENT /
+// NOT_FOUND for TLS files that do not go together or cannot be read.
 absl::StatusOr<std::unique_ptr<StatusServer>> StartStatusServer(const std::string& listen_address,
-                                                                CellController* cell);
+                                                                CellController* cell,
+                                                                const ServerTlsFiles& tls = {});
 
 }  // namespace cornerpose::robot_client

@@ -1,6 +1,7 @@
 #include "robot_client/config/robot_config.h"
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include "absl/strings/str_cat.h"
@@ -226,6 +227,15 @@ absl::StatusOr<RobotClientOptions> LoadRobotClientConfig(const std::string& path
   if (absl::Status s = ReadTextProtoFile(path, &config); !s.ok()) return s;
   absl::StatusOr<RobotClientOptions> options = OptionsFromProto(config);
   if (!options.ok()) return Invalid(absl::StrCat(path, ": ", options.status().message()));
+  // TLS files are relative to the file's directory, as the server's are.
+  const std::filesystem::path base = std::filesystem::path(path).parent_path();
+  for (std::string* file :
+       {&options->perception.tls_ca, &options->perception.tls_cert, &options->perception.tls_key,
+        &options->status_tls_cert, &options->status_tls_key, &options->status_tls_client_ca}) {
+    if (!file->empty() && std::filesystem::path(*file).is_relative()) {
+      *file = (base / *file).lexically_normal().string();
+    }
+  }
   if (absl::Status s = options->Validate(); !s.ok()) {
     return Invalid(absl::StrCat(path, ": ", s.message()));
   }

@@ -36,6 +36,12 @@ struct PerceptionClientOptions {
   // the last. Seconds; 0 < initial <= max.
   double reconnect_initial_s = 0.5;
   double reconnect_max_s = 10.0;
+  // TLS to the perception service (README, "TLS"): PEM files; tls_ca and/or
+  // tls_cert + tls_key set = TLS, all empty = plaintext.
+  std::string tls_ca;
+  std::string tls_cert;
+  std::string tls_key;
+  std::string tls_server_name;
 };
 
 struct RobotConnectionOptions {
@@ -183,7 +189,14 @@ struct RobotClientOptions {
   // required, and its TCP (FK * flange_T_tcp) must lie in the workspace.
   std::optional<ur::Joints> clear_joints;
   // host:port of the daemon's status service; port 0 picks a free port.
-  std::string status_listen_address = "0.0.0.0:50061";
+  // Loopback by default: the status service is for the cell's own computer
+  // unless it is given TLS and a wider address.
+  std::string status_listen_address = "127.0.0.1:50061";
+  // TLS of the status service (PEM files): cert + key = TLS; client_ca
+  // (needs both) = client certificates required. All empty = plaintext.
+  std::string status_tls_cert;
+  std::string status_tls_key;
+  std::string status_tls_client_ca;
   // Log the programs instead of sending them.
   bool dry_run = false;
   // Stop after this many picks; 0 = until the place pattern is full.

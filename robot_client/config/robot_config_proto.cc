@@ -23,6 +23,10 @@ using wire::Vector3dFromProto;
 absl::Status PerceptionFromProto(const v1::PerceptionClientConfig& perception,
                                  PerceptionClientOptions* p) {
   if (!perception.server_address().empty()) p->server_address = perception.server_address();
+  p->tls_ca = perception.tls_ca();
+  p->tls_cert = perception.tls_cert();
+  p->tls_key = perception.tls_key();
+  p->tls_server_name = perception.tls_server_name();
   p->source = perception.source();
   switch (perception.box_size_case()) {
     case v1::PerceptionClientConfig::kBox:
@@ -177,6 +181,9 @@ absl::Status RunFromProto(const v1::RobotClientConfig& config, RobotClientOption
   if (!config.status_listen_address().empty()) {
     options->status_listen_address = config.status_listen_address();
   }
+  options->status_tls_cert = config.status_tls_cert();
+  options->status_tls_key = config.status_tls_key();
+  options->status_tls_client_ca = config.status_tls_client_ca();
   options->dry_run = config.dry_run();
   options->max_picks = static_cast<int>(std::min<uint32_t>(config.max_picks(), 1000000000u));
   return absl::OkStatus();

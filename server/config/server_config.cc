@@ -62,6 +62,28 @@ absl::StatusOr<ServerOptions> LoadServerConfig(const std::string& path) {
   if (!config.view_box().empty()) options.http.view_box = config.view_box();
 
   const std::filesystem::path base = std::filesystem::path(path).parent_path();
+  const auto set_int = [&](bool has, int value, int* out) {
+    if (has) *out = value;
+  };
+  set_int(config.has_max_queued_detections(), config.max_queued_detections(),
+          &options.max_queued_detections);
+  set_int(config.has_max_streams(), config.max_streams(), &options.max_streams);
+  set_int(config.has_default_deadline_ms(), config.default_deadline_ms(),
+          &options.default_deadline_ms);
+  set_int(config.has_max_deadline_ms(), config.max_deadline_ms(), &options.max_deadline_ms);
+  set_int(config.has_shutdown_grace_ms(), config.shutdown_grace_ms(), &options.shutdown_grace_ms);
+  set_int(config.has_stall_timeout_ms(), config.stall_timeout_ms(), &options.stall_timeout_ms);
+  const auto resolve = [&](const std::string& file) {
+    if (file.empty()) return file;
+    std::filesystem::path p(file);
+    if (p.is_relative()) p = (base / p).lexically_normal();
+    return p.string();
+  };
+  options.tls_cert = resolve(config.tls_cert());
+  options.tls_key = resolve(config.tls_key());
+  options.tls_client_ca = resolve(config.tls_client_ca());
+  if (config.has_enable_reflection()) options.enable_reflection = config.enable_reflection();
+  if (absl::Status s = options.Validate(); !s.ok()) return Invalid(path, std::string(s.message()));
   std::set<std::string> names;
   for (int i = 0; i < config.sources_size(); ++i) {
     const v1::SourceConfig& source = config.sources(i);

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "common/box/box_models.h"
 #include "common/perception/detector.h"
 #include "server/http/http_options.h"
@@ -55,6 +56,39 @@ struct ServerOptions {
   // headless Kubernetes Service); calls in flight, streams included, run on
   // undisturbed. Seconds; 0 = never.
   int max_connection_age_s = 0;
+  // Admission control (see README, "Admission control"). Detect requests
+  // that may wait for a worker; one more is RESOURCE_EXHAUSTED. Each waiting
+  // request holds its message, so (max_concurrent_detections +
+  // max_queued_detections) x max_message_bytes bounds request memory.
+  // 0 to 10000.
+  int max_queued_detections = 8;
+  // StreamDetections calls open at once; one more is RESOURCE_EXHAUSTED.
+  // Each holds a thread and at most one queued detection. 0 to 10000.
+  int max_streams = 16;
+  // Deadline given to a Detect that brings none, milliseconds; 1 to
+  // max_deadline_ms.
+  int default_deadline_ms = 10000;
+  // Longest a Detect may run whatever deadline it brings, milliseconds;
+  // 1 to 3600000.
+  int max_deadline_ms = 60000;
+  // On shutdown, how long RPCs in flight may finish before they are
+  // cancelled, milliseconds; 0 to 600000. Streams are ended at once.
+  int shutdown_grace_ms = 5000;
+  // Health turns NOT_SERVING when detections are waiting or running and
+  // none has finished for this long (a wedged pool), and SERVING again once
+  // one does. Milliseconds; 10 to 3600000. Longer than the slowest
+  // detection the server accepts.
+  int stall_timeout_ms = 15000;
+
+  // TLS (see README, "TLS"). PEM files; all empty = plaintext. tls_cert and
+  // tls_key go together; tls_client_ca (needs both) makes client
+  // certificates required and verified against it.
+  std::string tls_cert{};
+  std::string tls_key{};
+  std::string tls_client_ca{};
+  // gRPC server reflection (grpcurl without the protos). Off in production.
+  bool enable_reflection = true;
+
   // The detector options every request starts from (its box is unused: a
   // request names the box).
   DetectorOptions detector;
@@ -66,6 +100,11 @@ struct ServerOptions {
   std::vector<SourceSpec> sources;
   // The HTTP port: the web view, its JSON API and /metrics (http_options.h).
   HttpOptions http;
+
+  // OK, or INVALID_ARGUMENT naming the first field out of range (its value
+  // and range) or a TLS file set without its partner. Sources and the
+  // detector are checked by their own loaders.
+  absl::Status Validate() const;
 };
 
 }  // namespace cornerpose::server

@@ -20,8 +20,8 @@ namespace {
 // OK while the caller still wants the answer. Checked before and after the
 // detector (which cannot be interrupted), so a request that waited in the
 // queue past its deadline costs no detection, and a late one no conversion.
-grpc::Status CheckStillWanted(grpc::CallbackServerContext& context) {
-  if (context.deadline() <= std::chrono::system_clock::now()) {
+grpc::Status CheckStillWanted(grpc::CallbackServerContext& context, absl::Time deadline) {
+  if (deadline <= absl::Now()) {
     return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, "deadline exceeded");
   }
   if (context.IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
@@ -51,20 +51,33 @@ v1::SourceState ToProto(SourceState state) {
 // UNAVAILABLE when the source failed or has no frame in time.
 absl::StatusOr<Frame> GrabFromSource(
     const std::map<std::string, std::unique_ptr<FrameSource>>& sources, const std::string& name,
-    grpc::CallbackServerContext& context) {
+    absl::Time deadline) {
   auto it = sources.find(name);
   if (it == sources.end()) {
     return absl::NotFoundError(absl::StrCat("unknown source '", name, "'"));
   }
-  const absl::Duration until_deadline = absl::FromChrono(context.deadline()) - absl::Now();
+  const absl::Duration until_deadline = deadline - absl::Now();
   return it->second->Grab(std::min(kMaxFrameWait, until_deadline));
 }
 
-grpc::Status RunDetect(grpc::CallbackServerContext& context, const v1::DetectRequest& request,
+// The caller's deadline capped at limits.max_deadline, or
+// limits.default_deadline when the caller set none.
+absl::Time EffectiveDeadline(const grpc::CallbackServerContext& context,
+                             const ServiceLimits& limits) {
+  const absl::Time now = absl::Now();
+  // gRPC reports "no deadline" as the far future.
+  if (context.deadline() >= std::chrono::system_clock::now() + std::chrono::hours(24 * 365 * 100)) {
+    return now + limits.default_deadline;
+  }
+  return std::min(absl::FromChrono(context.deadline()), now + limits.max_deadline);
+}
+
+grpc::Status RunDetect(grpc::CallbackServerContext& context, absl::Time deadline,
+                       const v1::DetectRequest& request,
                        const DetectorOptions& defaults, const BoxModels& box_models,
                        const std::map<std::string, std::unique_ptr<FrameSource>>& sources,
                        v1::DetectResponse& response) {
-  if (grpc::Status s = CheckStillWanted(context); !s.ok()) return s;
+  if (grpc::Status s = CheckStillWanted(context, deadline); !s.ok()) return s;
   absl::StatusOr<DetectorOptions> options =
       DetectorOptionsFromRequest(request, defaults, box_models);
   if (!options.ok()) return ToGrpcStatus(options.status());
@@ -77,7 +90,7 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, const v1::DetectReq
           "color is for a cloud or depth_image sent with the request; a source's frames bring "
           "their own"));
     }
-    absl::StatusOr<Frame> grabbed = GrabFromSource(sources, request.source(), context);
+    absl::StatusOr<Frame> grabbed = GrabFromSource(sources, request.source(), deadline);
     if (!grabbed.ok()) return ToGrpcStatus(grabbed.status());
     frame = *std::move(grabbed);
     cloud = &frame->cloud;
@@ -88,12 +101,12 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, const v1::DetectReq
     if (!sent.ok()) return ToGrpcStatus(sent.status());
     cloud = &*sent;
   }
-  if (grpc::Status s = CheckStillWanted(context); !s.ok()) return s;
+  if (grpc::Status s = CheckStillWanted(context, deadline); !s.ok()) return s;
 
   absl::StatusOr<Detection> detection = DetectBoxes(*cloud, *options);
   if (!detection.ok()) return ToGrpcStatus(detection.status());
 
-  if (grpc::Status s = CheckStillWanted(context); !s.ok()) return s;
+  if (grpc::Status s = CheckStillWanted(context, deadline); !s.ok()) return s;
   response = MakeDetectResponse(*detection, *options, frame ? &*frame : nullptr,
                                 {.include_edge_points = request.include_edge_points(),
                                  .include_cloud = request.include_cloud()});
@@ -104,8 +117,11 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, const v1::DetectReq
 
 PerceptionServiceImpl::PerceptionServiceImpl(DetectionPool* pool, DetectorOptions defaults,
                                              std::vector<std::unique_ptr<FrameSource>> sources,
-                                             BoxModels box_models)
-    : pool_(pool), defaults_(std::move(defaults)), box_models_(std::move(box_models)) {
+                                             BoxModels box_models, ServiceLimits limits)
+    : pool_(pool),
+      defaults_(std::move(defaults)),
+      box_models_(std::move(box_models)),
+      limits_(limits) {
   for (std::unique_ptr<FrameSource>& source : sources) {
     const std::string name = source->name();
     sources_.emplace(name, std::move(source));
@@ -116,10 +132,25 @@ grpc::ServerUnaryReactor* PerceptionServiceImpl::Detect(grpc::CallbackServerCont
                                                         const v1::DetectRequest* request,
                                                         v1::DetectResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  // A bad box or override is refused before it can take a queue slot (cheap;
+  // the cloud itself is checked on the worker).
+  if (absl::StatusOr<DetectorOptions> options =
+          DetectorOptionsFromRequest(*request, defaults_, box_models_);
+      !options.ok()) {
+    reactor->Finish(ToGrpcStatus(options.status()));
+    return reactor;
+  }
+  const absl::Time deadline = EffectiveDeadline(*context, limits_);
   // context, request and response stay valid until Finish.
-  pool_->Submit([this, context, request, response, reactor] {
-    reactor->Finish(RunDetect(*context, *request, defaults_, box_models_, sources_, *response));
+  const bool queued = pool_->TrySubmit([this, context, deadline, request, response, reactor] {
+    reactor->Finish(
+        RunDetect(*context, deadline, *request, defaults_, box_models_, sources_, *response));
   });
+  if (!queued) {
+    // Refused at once, so a client can back off or try another replica.
+    reactor->Finish(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                                 "detection queue full; retry later or on another replica"));
+  }
   return reactor;
 }
 
@@ -146,18 +177,36 @@ namespace cornerpose::server {
 
 grpc::ServerWriteReactor<v1::DetectResponse>* PerceptionServiceImpl::StreamDetections(
     grpc::CallbackServerContext* /*context*/, const v1::StreamDetectionsRequest* request) {
+  if (open_streams_.fetch_add(1) >= limits_.max_streams) {
+    open_streams_.fetch_sub(1);
+    return new StreamDetectionsReactor(grpc::Status(
+        grpc::StatusCode::RESOURCE_EXHAUSTED,
+        absl::StrCat("too many open streams (max_streams ", limits_.max_streams, ")")));
+  }
+  // Every early return below hands the slot back in the error reactor's
+  // stead.
+  const auto refuse = [this](const absl::Status& status) {
+    open_streams_.fetch_sub(1);
+    return new StreamDetectionsReactor(ToGrpcStatus(status));
+  };
   absl::StatusOr<DetectorOptions> options =
       DetectorOptionsFromRequest(*request, defaults_, box_models_);
-  if (!options.ok()) return new StreamDetectionsReactor(ToGrpcStatus(options.status()));
+  if (!options.ok()) return refuse(options.status());
   auto it = sources_.find(request->source());
   if (it == sources_.end()) {
-    return new StreamDetectionsReactor(ToGrpcStatus(
-        absl::NotFoundError(absl::StrCat("unknown source '", request->source(), "'"))));
+    return refuse(absl::NotFoundError(absl::StrCat("unknown source '", request->source(), "'")));
   }
-  return new StreamDetectionsReactor(pool_, it->second.get(), *std::move(options),
+  // Streams whose requests differ only in what the response carries share
+  // their detections.
+  v1::StreamDetectionsRequest parameters = *request;
+  parameters.clear_include_edge_points();
+  parameters.clear_include_cloud();
+  std::string share_key = parameters.SerializeAsString();
+  return new StreamDetectionsReactor(pool_, &shared_, std::move(share_key), it->second.get(),
+                                     *std::move(options),
                                      {.include_edge_points = request->include_edge_points(),
                                       .include_cloud = request->include_cloud()},
-                                     &stopping_streams_);
+                                     &stopping_streams_, &open_streams_);
 }
 
 }  // namespace cornerpose::server

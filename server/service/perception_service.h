@@ -9,13 +9,23 @@
 #include <string>
 #include <vector>
 
+#include "absl/time/time.h"
+
 #include "common/perception/detector.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "server/service/detect_request.h"
 #include "server/service/detection_pool.h"
+#include "server/service/shared_detections.h"
 #include "server/sources/frame_source.h"
 
 namespace cornerpose::server {
+
+// What the handlers admit (ServerOptions documents each, with its range).
+struct ServiceLimits {
+  int max_streams = 16;
+  absl::Duration default_deadline = absl::Seconds(10);
+  absl::Duration max_deadline = absl::Seconds(60);
+};
 
 class PerceptionServiceImpl final : public v1::PerceptionService::CallbackService {
  public:
@@ -26,7 +36,7 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
   // requests can name; the service owns them, so they stop after the server.
   PerceptionServiceImpl(DetectionPool* pool, DetectorOptions defaults,
                         std::vector<std::unique_ptr<FrameSource>> sources = {},
-                        BoxModels box_models = {});
+                        BoxModels box_models = {}, ServiceLimits limits = {});
 
   grpc::ServerUnaryReactor* Detect(grpc::CallbackServerContext* context,
                                    const v1::DetectRequest* request,
@@ -52,6 +62,9 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
     for (const auto& [name, source] : sources_) out.push_back(source.get());
     return out;
   }
+  // Detections streams started (shared ones counted once), and streams open.
+  uint64_t stream_detections_started() const { return shared_.started(); }
+  int open_streams() const { return open_streams_.load(); }
 
  private:
   DetectionPool* pool_;
@@ -59,7 +72,10 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
   const BoxModels box_models_;
   // By name; fixed after construction, so read without a lock.
   std::map<std::string, std::unique_ptr<FrameSource>> sources_;
+  const ServiceLimits limits_;
+  SharedDetections shared_;
   std::atomic<bool> stopping_streams_{false};
+  std::atomic<int> open_streams_{0};
 };
 
 }  // namespace cornerpose::server

@@ -1,6 +1,5 @@
 #include "server/service/stream_detections.h"
 
-#include <future>
 #include <utility>
 
 #include "absl/time/clock.h"
@@ -16,14 +15,19 @@ constexpr absl::Duration kPollPeriod = absl::Milliseconds(100);
 
 StreamDetectionsReactor::StreamDetectionsReactor(const grpc::Status& error) { Finish(error); }
 
-StreamDetectionsReactor::StreamDetectionsReactor(DetectionPool* pool, FrameSource* source,
+StreamDetectionsReactor::StreamDetectionsReactor(DetectionPool* pool, SharedDetections* shared,
+                                                 std::string share_key, FrameSource* source,
                                                  DetectorOptions options, ResponseContents contents,
-                                                 const std::atomic<bool>* stopping)
+                                                 const std::atomic<bool>* stopping,
+                                                 std::atomic<int>* open_streams)
     : pool_(pool),
+      shared_(shared),
+      share_key_(std::move(share_key)),
       source_(source),
       options_(std::move(options)),
       contents_(contents),
-      stopping_(stopping) {
+      stopping_(stopping),
+      open_streams_(open_streams) {
   thread_ = std::thread([this] { Run(); });
 }
 
@@ -53,7 +57,11 @@ void StreamDetectionsReactor::OnDone() {
       thread_.join();
     }
   }
+  // Last, so a server waiting for its streams to end sees none still
+  // touching the service.
+  std::atomic<int>* open_streams = open_streams_;
   delete this;
+  if (open_streams != nullptr) open_streams->fetch_sub(1);
 }
 
 grpc::Status StreamDetectionsReactor::ShouldStop() {
@@ -81,17 +89,15 @@ void StreamDetectionsReactor::Run() {
     }
     last_id = frame->id;
 
-    std::promise<absl::StatusOr<Detection>> done;
-    std::future<absl::StatusOr<Detection>> detection = done.get_future();
-    DetectorOptions options = options_;
-    UseFrameCamera(frame->camera, &options);  // as Detect does
-    pool_->Submit([&] { done.set_value(DetectBoxes(frame->cloud, options)); });
-    absl::StatusOr<Detection> result = detection.get();
+    // Held until the next frame's, so a stream a frame behind still finds
+    // this one to share.
+    current_ = shared_->Get(share_key_, *std::move(frame), options_, pool_);
+    const absl::StatusOr<Detection>& result = current_->result.get();
     if (!result.ok()) {
       end = ToGrpcStatus(result.status());
       break;
     }
-    response_ = MakeDetectResponse(*result, options, &*frame, contents_);
+    response_ = MakeDetectResponse(*result, current_->options, current_->frame.get(), contents_);
 
     std::unique_lock<std::mutex> lock(mutex_);
     write_pending_ = true;

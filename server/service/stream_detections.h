@@ -4,20 +4,24 @@
 
 #include <atomic>
 #include <condition_variable>
+#include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 
 #include "common/perception/detector.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "server/service/detect_response.h"
 #include "server/service/detection_pool.h"
+#include "server/service/shared_detections.h"
 #include "server/sources/frame_source.h"
 
 namespace cornerpose::server {
 
 // Each stream has a thread that waits for frames (so waiting never occupies
-// a detection worker), runs each detection on the pool (so streams share
-// the bound on concurrent detections with Detect), and waits for the write
+// a detection worker), gets each frame's detection from `shared` (run on the
+// pool, so streams share the bound on concurrent detections with Detect, and
+// shared with every stream of the same source and parameters), and waits for the write
 // before grabbing again: a slow client therefore gets the newest frame next,
 // never a backlog. Deletes itself when the RPC is done.
 class StreamDetectionsReactor final : public grpc::ServerWriteReactor<v1::DetectResponse> {
@@ -25,9 +29,12 @@ class StreamDetectionsReactor final : public grpc::ServerWriteReactor<v1::Detect
   // Finishes at once with `error` (a request refused before streaming).
   explicit StreamDetectionsReactor(const grpc::Status& error);
   // Streams until cancelled, the source ends or fails, or *stopping is set
-  // (server shutdown). Everything pointed to outlives the RPC.
-  StreamDetectionsReactor(DetectionPool* pool, FrameSource* source, DetectorOptions options,
-                          ResponseContents contents, const std::atomic<bool>* stopping);
+  // (server shutdown). `share_key` names the source and the parameters that
+  // change the detection. *open_streams is decremented when the RPC is done.
+  // Everything pointed to outlives the RPC.
+  StreamDetectionsReactor(DetectionPool* pool, SharedDetections* shared, std::string share_key,
+                          FrameSource* source, DetectorOptions options, ResponseContents contents,
+                          const std::atomic<bool>* stopping, std::atomic<int>* open_streams);
 
   void OnWriteDone(bool ok) override;
   void OnCancel() override;
@@ -39,10 +46,13 @@ class StreamDetectionsReactor final : public grpc::ServerWriteReactor<v1::Detect
   grpc::Status ShouldStop();
 
   DetectionPool* pool_ = nullptr;
+  SharedDetections* shared_ = nullptr;
+  const std::string share_key_;
   FrameSource* source_ = nullptr;
   const DetectorOptions options_;
   const ResponseContents contents_;
   const std::atomic<bool>* stopping_ = nullptr;
+  std::atomic<int>* open_streams_ = nullptr;
 
   std::mutex mutex_;
   std::condition_variable changed_;
@@ -50,6 +60,7 @@ class StreamDetectionsReactor final : public grpc::ServerWriteReactor<v1::Detect
   bool write_ok_ = true;         // guarded by mutex_
   bool cancelled_ = false;       // guarded by mutex_
   v1::DetectResponse response_;  // owned by the write in flight
+  std::shared_ptr<const SharedDetection> current_;  // Run's thread only
   std::thread thread_;
 };
 

@@ -405,8 +405,14 @@ class KubernetesTest(DeployTestCase):
     def test_ports_and_probes(self):
         grpc = next(p for p in self.container["ports"] if p["name"] == "grpc")
         self.assertEqual(grpc["containerPort"], self.ports.server)
+        # Mutual TLS: exec probes run the CLI's health check with the
+        # Secret's client certificate on the server's port.
         for probe in ("startupProbe", "readinessProbe", "livenessProbe"):
-            self.assertEqual(self.container[probe]["grpc"]["port"], self.ports.server, probe)
+            argv = self.container[probe]["exec"]["command"]
+            self.check_command(argv, f"deployment.yaml {probe}")
+            self.assertEqual(port_of(flag_value(argv, "server")), self.ports.server, probe)
+            for flag in ("tls_ca", "tls_cert", "tls_key"):
+                self.assertTrue(flag_value(argv, flag).startswith("/etc/cornerpose/tls/"), probe)
         service = self.docs[("Service", "cornerpose-perception")]
         self.assertEqual(service["spec"]["clusterIP"], "None", "headless, for per-call balancing")
         sp = service["spec"]["ports"][0]
@@ -439,6 +445,26 @@ class KubernetesTest(DeployTestCase):
         cores = lambda q: float(q[:-1]) / 1000 if str(q).endswith("m") else float(q)
         self.assertGreaterEqual(cores(res["requests"]["cpu"]), 2)
         self.assertEqual(cores(res["limits"]["cpu"]), 2 * concurrent)
+        # Memory follows the admission limits (see deployment.yaml).
+        field = lambda name, default: int(textproto_field(text, name) or default)
+        mib = lambda q: int(str(q)[:-2]) * (1024 if str(q).endswith("Gi") else 1)
+        need = (128 + (2 * concurrent + field("max_queued_detections", 8)) *
+                field("max_message_bytes", 67108864) / 2**20 + field("max_streams", 16) * 8)
+        self.assertGreaterEqual(mib(res["limits"]["memory"]), need)
+
+    def test_tls_and_reflection_off(self):
+        cmd = self.container["command"] + self.container.get("args", [])
+        self.assertEqual(flag_value(cmd, "reflection"), "false")
+        tls = next(v for v in self.pod["volumes"] if v["name"] == "tls")
+        mount = next(m for m in self.container["volumeMounts"] if m["name"] == "tls")
+        for flag in ("tls_cert", "tls_key", "tls_client_ca"):
+            self.assertEqual(os.path.dirname(flag_value(cmd, flag)), mount["mountPath"], flag)
+        self.assertIn("secretName", tls["secret"])
+        policy = self.docs[("NetworkPolicy", "cornerpose-perception")]
+        self.assertEqual(policy["spec"]["podSelector"]["matchLabels"],
+                         self.deployment["spec"]["selector"]["matchLabels"])
+        ports = [p["port"] for rule in policy["spec"]["ingress"] for p in rule["ports"]]
+        self.assertEqual(ports, [self.ports.server])
 
     def test_user_matches_image(self):
         users = [l.split()[1] for l in read("docker", "Dockerfile").splitlines()

@@ -80,7 +80,7 @@ TEST(RunFromProtoTest, ClearJointsMustBeSix) {
   ASSERT_TRUE(options.clear_joints.has_value());
   EXPECT_EQ((*options.clear_joints)[5], 0.5);
   EXPECT_EQ(options.max_picks, 3);
-  EXPECT_EQ(options.status_listen_address, "0.0.0.0:50061");
+  EXPECT_EQ(options.status_listen_address, "127.0.0.1:50061");
 }
 
 }  // namespace

@@ -47,7 +47,7 @@ TEST(RobotConfigTest, ShippedConfigLoadsWithItsValues) {
   EXPECT_EQ(options->place_pattern.slot_count(), 12);
   ASSERT_TRUE(options->clear_joints.has_value());
   EXPECT_DOUBLE_EQ((*options->clear_joints)[4], -1.5708);
-  EXPECT_EQ(options->status_listen_address, "0.0.0.0:50061");
+  EXPECT_EQ(options->status_listen_address, "127.0.0.1:50061");
   EXPECT_FALSE(options->dry_run);
   EXPECT_EQ(options->max_picks, 0);
 }
@@ -171,7 +171,7 @@ clear_joints_rad: [0, -1.5708, 1.5708, -1.5708, -1.5708, 0]
   // The layer height defaults to the box height.
   EXPECT_DOUBLE_EQ(options->place_pattern.layer_height_m, 0.25);
   EXPECT_DOUBLE_EQ(options->motion.linear_speed_m_s, defaults.motion.linear_speed_m_s);
-  EXPECT_EQ(options->status_listen_address, "0.0.0.0:50061");
+  EXPECT_EQ(options->status_listen_address, "127.0.0.1:50061");
 }
 
 TEST(RobotConfigTest, DefaultStructsNeedTheRequiredFields) {

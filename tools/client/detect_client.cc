@@ -77,7 +77,9 @@ absl::Status Detect(const CommandArgs& args) {
     request.set_include_cloud(common->outputs.need_cloud());
   }
 
-  std::shared_ptr<grpc::Channel> channel = MakeChannel(common->server);
+  absl::StatusOr<std::shared_ptr<grpc::Channel>> made = MakeChannel(common->server, TlsFilesFromArgs(args));
+  if (!made.ok()) return made.status();
+  std::shared_ptr<grpc::Channel> channel = *std::move(made);
   std::unique_ptr<v1::PerceptionService::Stub> stub = v1::PerceptionService::NewStub(channel);
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() +
@@ -111,16 +113,16 @@ absl::Status Detect(const CommandArgs& args) {
 }  // namespace
 
 int RunClientDetect(const std::vector<std::string>& argv) {
-  if (PrintHelpIfAsked(argv, kHelp)) return 0;
+  if (PrintHelpIfAsked(argv, HelpWithTls(kHelp).c_str())) return 0;
   absl::StatusOr<CommandArgs> args =
       ParseCommandArgs(argv,
-                       {"server", "cloud", "source", "box", "intrinsics", "json", "ply", "png",
-                        "edges", "deadline_ms"},
+                       WithTlsOptions({"server", "cloud", "source", "box", "intrinsics", "json", "ply", "png",
+                        "edges", "deadline_ms"}),
                        {"quiet"}, {"server", "box"});
   if (args.ok() && args->Get("cloud").has_value() == args->Get("source").has_value()) {
     args = absl::InvalidArgumentError("give exactly one of --cloud FILE and --source NAME");
   }
-  if (!args.ok()) return ReportUsageError("detect", args.status(), kHelp);
+  if (!args.ok()) return ReportUsageError("detect", args.status(), HelpWithTls(kHelp).c_str());
   return ReportClientResult("detect", Detect(*args));
 }
 

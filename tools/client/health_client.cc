@@ -31,7 +31,9 @@ absl::Status Check(const CommandArgs& args) {
   const std::string server = *args.Get("server");
   int deadline_ms = 2000;
   if (absl::Status s = args.SetInt("deadline_ms", &deadline_ms); !s.ok()) return s;
-  std::shared_ptr<grpc::Channel> channel = MakeChannel(server);
+  absl::StatusOr<std::shared_ptr<grpc::Channel>> made = MakeChannel(server, TlsFilesFromArgs(args));
+  if (!made.ok()) return made.status();
+  std::shared_ptr<grpc::Channel> channel = *std::move(made);
   auto stub = grpc::health::v1::Health::NewStub(channel);
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(deadline_ms));
@@ -52,10 +54,10 @@ absl::Status Check(const CommandArgs& args) {
 }  // namespace
 
 int RunClientHealth(const std::vector<std::string>& argv) {
-  if (PrintHelpIfAsked(argv, kHelp)) return 0;
+  if (PrintHelpIfAsked(argv, HelpWithTls(kHelp).c_str())) return 0;
   absl::StatusOr<CommandArgs> args =
-      ParseCommandArgs(argv, {"server", "service", "deadline_ms"}, {"quiet"}, {"server"});
-  if (!args.ok()) return ReportUsageError("health", args.status(), kHelp);
+      ParseCommandArgs(argv, WithTlsOptions({"server", "service", "deadline_ms"}), {"quiet"}, {"server"});
+  if (!args.ok()) return ReportUsageError("health", args.status(), HelpWithTls(kHelp).c_str());
   return ReportClientResult("health", Check(*args));
 }
 

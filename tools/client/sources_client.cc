@@ -26,7 +26,9 @@ absl::Status ListSources(const CommandArgs& args) {
   const std::string server = *args.Get("server");
   int deadline_ms = 5000;
   if (absl::Status s = args.SetInt("deadline_ms", &deadline_ms); !s.ok()) return s;
-  std::shared_ptr<grpc::Channel> channel = MakeChannel(server);
+  absl::StatusOr<std::shared_ptr<grpc::Channel>> made = MakeChannel(server, TlsFilesFromArgs(args));
+  if (!made.ok()) return made.status();
+  std::shared_ptr<grpc::Channel> channel = *std::move(made);
   std::unique_ptr<v1::PerceptionService::Stub> stub = v1::PerceptionService::NewStub(channel);
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(deadline_ms));
@@ -48,10 +50,10 @@ absl::Status ListSources(const CommandArgs& args) {
 }  // namespace
 
 int RunClientSources(const std::vector<std::string>& argv) {
-  if (PrintHelpIfAsked(argv, kHelp)) return 0;
+  if (PrintHelpIfAsked(argv, HelpWithTls(kHelp).c_str())) return 0;
   absl::StatusOr<CommandArgs> args =
-      ParseCommandArgs(argv, {"server", "deadline_ms"}, {}, {"server"});
-  if (!args.ok()) return ReportUsageError("sources", args.status(), kHelp);
+      ParseCommandArgs(argv, WithTlsOptions({"server", "deadline_ms"}), {}, {"server"});
+  if (!args.ok()) return ReportUsageError("sources", args.status(), HelpWithTls(kHelp).c_str());
   return ReportClientResult("sources", ListSources(*args));
 }
 

@@ -76,7 +76,9 @@ absl::Status Stream(const CommandArgs& args) {
   request.set_include_edge_points(common->outputs.need_edge_points());
   request.set_include_cloud(common->outputs.need_cloud());
 
-  std::shared_ptr<grpc::Channel> channel = MakeChannel(common->server);
+  absl::StatusOr<std::shared_ptr<grpc::Channel>> made = MakeChannel(common->server, TlsFilesFromArgs(args));
+  if (!made.ok()) return made.status();
+  std::shared_ptr<grpc::Channel> channel = *std::move(made);
   // Fail fast when the server is not there; the stream itself has no deadline.
   if (!channel->WaitForConnected(std::chrono::system_clock::now() +
                                  std::chrono::milliseconds(common->deadline_ms))) {
@@ -133,11 +135,13 @@ absl::Status Stream(const CommandArgs& args) {
 }  // namespace
 
 int RunClientStream(const std::vector<std::string>& argv) {
-  if (PrintHelpIfAsked(argv, kHelp)) return 0;
+  if (PrintHelpIfAsked(argv, HelpWithTls(kHelp).c_str())) return 0;
   absl::StatusOr<CommandArgs> args = ParseCommandArgs(
-      argv, {"server", "source", "box", "frames", "json", "ply", "png", "edges", "deadline_ms"},
+      argv,
+      WithTlsOptions(
+          {"server", "source", "box", "frames", "json", "ply", "png", "edges", "deadline_ms"}),
       {"quiet"}, {"server", "source", "box"});
-  if (!args.ok()) return ReportUsageError("stream", args.status(), kHelp);
+  if (!args.ok()) return ReportUsageError("stream", args.status(), HelpWithTls(kHelp).c_str());
   return ReportClientResult("stream", Stream(*args));
 }
 

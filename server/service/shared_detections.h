@@ -1,0 +1,46 @@
+// Fan-out for StreamDetections: streams on the same source with the same
+// detection parameters share one detection per frame, so N viewers of a
+// camera cost one detector run per frame, not N.
+#pragma once
+
+#include <cstdint>
+#include <future>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "common/perception/detector.h"
+#include "server/service/detection_pool.h"
+#include "server/sources/frame_source.h"
+
+namespace cornerpose::server {
+
+// One frame's detection, shared by the streams that asked for it.
+struct SharedDetection {
+  uint64_t frame_id = 0;
+  std::shared_ptr<const Frame> frame;
+  DetectorOptions options;  // with the frame's camera applied
+  std::shared_future<absl::StatusOr<Detection>> result;
+};
+
+class SharedDetections {
+ public:
+  // The detection of `frame` under `key` (the source and the parameters that
+  // change the detection): the one another stream already started for this
+  // frame, or a new one run on `pool`. The entry lives while a stream holds
+  // it, so a stream keeps the last one until it has the next.
+  std::shared_ptr<const SharedDetection> Get(const std::string& key, Frame frame,
+                                             const DetectorOptions& options, DetectionPool* pool);
+  // Detections started (not shared) since construction.
+  uint64_t started() const;
+
+ private:
+  mutable std::mutex mutex_;
+  // Latest per key; expired entries are dropped as new ones go in.
+  std::map<std::string, std::weak_ptr<const SharedDetection>> latest_;  // guarded by mutex_
+  uint64_t started_ = 0;                                                 // guarded by mutex_
+};
+
+}  // namespace cornerpose::server
