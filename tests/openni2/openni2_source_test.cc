@@ -133,7 +133,11 @@ TEST_F(OpenNi2SourceTest, RecordingPlayedOnceFinishesAfterItsLastFrame) {
   const std::vector<int> matched = ReadFrames(source, 100, &finished);
   EXPECT_TRUE(finished);
   EXPECT_GE(matched.size(), 2u);
-  EXPECT_LE(matched.size(), 12u);  // about 12 were recorded, each delivered at most once
+  // Each recorded frame is delivered at most once (the recorder may have
+  // written a few more than the 12 asked for when the machine is busy).
+  const int recorded = openni2_test::OniDepthFrameCount(*recording_);
+  ASSERT_GE(recorded, 2);
+  EXPECT_LE(matched.size(), static_cast<size_t>(recorded));
   EXPECT_EQ(source.state().state, SourceState::kFinished);
   // The newest frame stays available after the end.
   EXPECT_TRUE(source.Grab(absl::Seconds(1)).ok());

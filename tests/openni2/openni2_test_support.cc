@@ -7,6 +7,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <OpenNI.h>
+
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "common/io/cloud_io.h"
@@ -75,6 +77,22 @@ std::string RecordOni(const std::string& directory, const std::string& out, int 
   std::error_code error;
   if (fs::file_size(out, error) == 0 || error) return absl::StrCat(out, " is missing or empty");
   return "";
+}
+
+int OniDepthFrameCount(const std::string& path) {
+  if (openni::OpenNI::initialize() != openni::STATUS_OK) return -1;
+  openni::Device device;
+  if (device.open(path.c_str()) != openni::STATUS_OK) return -1;
+  int count = -1;
+  openni::VideoStream depth;
+  if (depth.create(device, openni::SENSOR_DEPTH) == openni::STATUS_OK) {
+    if (openni::PlaybackControl* playback = device.getPlaybackControl(); playback != nullptr) {
+      count = playback->getNumberOfFrames(depth);
+    }
+    depth.destroy();
+  }
+  device.close();
+  return count;
 }
 
 }  // namespace cornerpose::openni2_test

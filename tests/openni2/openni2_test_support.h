@@ -28,4 +28,9 @@ int MatchCloud(const PointCloud& cloud, const std::vector<PointCloud>& expected,
 // to `out` with oni_record (at most 60 s). Empty on success, else why not.
 std::string RecordOni(const std::string& directory, const std::string& out, int frames);
 
+// The number of depth frames OpenNI2 finds in the recording `path`, or -1.
+// OpenNI2's recorder runs asynchronously, so this can exceed the count asked
+// of RecordOni when the machine is busy.
+int OniDepthFrameCount(const std::string& path);
+
 }  // namespace cornerpose::openni2_test
