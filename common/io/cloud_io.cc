@@ -198,7 +198,7 @@ absl::StatusOr<PointCloud> LoadDepthImage(const std::string& path, const LoadOpt
   PointCloud cloud = DepthToCloud(*depth, camera, options.depth_scale_m);
   // A colour image registered to the depth image: NAME.color.png beside
   // NAME.png (the recorded-frame convention), used when it is there.
-  if (!options.color_path) {
+  if (!options.color_path && options.color_from_beside) {
     const std::filesystem::path p(path);
     const std::filesystem::path beside =
         p.parent_path() / (p.stem().string() + ".color.png");

@@ -25,6 +25,10 @@ struct LoadOptions {
   // NAME.color.png from beside it when there is one; a PCD keeps its own
   // rgb/rgba field.
   std::optional<std::string> color_path;
+  // Whether a depth image NAME.png looks for NAME.color.png beside it when
+  // color_path is unset (a mismatched one is then an error). The directory
+  // source turns this off and attaches colour itself, leniently.
+  bool color_from_beside = true;
 };
 
 // Loads a cloud, by extension (case-insensitive):

@@ -44,29 +44,13 @@ fs::path ColorPathFor(const fs::path& frame) {
 // PCD with rgb fields) keeps it. A colour image that does not load or does
 // not match the frame's size is reported and the frame plays without it:
 // depth alone still detects.
-void AttachColor(const fs::path& frame, PointCloud* cloud, absl::string_view source) {
+void AttachColorIfBeside(const fs::path& frame, PointCloud* cloud, absl::string_view source) {
   if (cloud->has_color()) return;
   const fs::path color_path = ColorPathFor(frame);
   std::error_code error;
   if (!fs::exists(color_path, error)) return;
-  int width = 0;
-  int height = 0;
-  absl::StatusOr<std::vector<uint8_t>> rgb = ReadRgbPng(color_path.string(), &width, &height);
-  if (!rgb.ok()) {
-    std::cerr << "source " << source << ": " << color_path.string()
-              << ": colour not used: " << rgb.status().message() << "\n";
-    return;
-  }
-  if (width != cloud->width || height != cloud->height) {
-    std::cerr << "source " << source << ": " << color_path.string()
-              << ": colour not used: " << width << " x " << height << " but the frame is "
-              << cloud->width << " x " << cloud->height << "\n";
-    return;
-  }
-  cloud->rgb.resize(cloud->size());
-  for (size_t i = 0; i < cloud->rgb.size(); ++i) {
-    cloud->rgb[i] = (uint32_t{(*rgb)[3 * i]} << 16) | (uint32_t{(*rgb)[3 * i + 1]} << 8) |
-                    uint32_t{(*rgb)[3 * i + 2]};
+  if (absl::Status s = AttachColor(color_path.string(), cloud); !s.ok()) {
+    std::cerr << "source " << source << ": colour not used: " << s.message() << "\n";
   }
 }
 
@@ -141,6 +125,7 @@ void DirectorySource::Run() {
   // Depth images need the camera; without it every PNG is skipped (and the
   // PCDs, if any, still play), so the error is logged rather than fatal.
   LoadOptions load_options;
+  load_options.color_from_beside = false;  // attached below, leniently
   if (listing->has_png) {
     absl::StatusOr<CameraIntrinsics> camera = ReadIntrinsics(directory_);
     if (camera.ok()) {
@@ -166,7 +151,7 @@ void DirectorySource::Run() {
       any_loaded = true;
       Frame frame;
       frame.cloud = *std::move(cloud);
-      AttachColor(path, &frame.cloud, name_);
+      AttachColorIfBeside(path, &frame.cloud, name_);
       if (absl::AsciiStrToLower(fs::path(path).extension().string()) == ".png") {
         frame.camera = load_options.intrinsics;
       }
