@@ -505,17 +505,23 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
     const FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
     const Eigen::Vector3d axis_dir[2] = {f.a, f.b};
     const double size[2] = {2 * f.half_a, 2 * f.half_b};
-    // Per axis, the run of the plane through the box along three lines.
+    // Per axis, the run of the plane through the box along three lines:
+    // past a continuing side, and past a seam too (the layer goes on beyond
+    // a touching box; a false seam in the middle of a face must not make a
+    // box-wide strip of it).
     std::array<std::array<double, 3>, 2> extent = {
         {{size[0], size[0], size[0]}, {size[1], size[1], size[1]}}};
     bool measured = true;
     for (int ax = 0; ax < 2 && measured; ++ax) {
       for (int sgn = 0; sgn < 2 && measured; ++sgn) {
-        if (result.sides[2 * ax + sgn] != SideKind::kContinues) continue;
+        const SideKind kind = result.sides[2 * ax + sgn];
+        if (kind != SideKind::kContinues && kind != SideKind::kSeam) continue;
         const Eigen::Vector3d across = sgn == 0 ? axis_dir[ax] : -axis_dir[ax];
         const auto runs = LayerRunsBeyond(depth, f.c + 0.5 * size[ax] * across, across,
                                           axis_dir[1 - ax], 0.5 * size[1 - ax], f.n, options);
         if (!runs) {
+          // Past a seam the layer may leave the image: it then says nothing.
+          if (kind == SideKind::kSeam) continue;
           measured = false;
           break;
         }

@@ -247,6 +247,14 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   }
 
   std::vector<DeclinedCandidate> declined;
+  // Planar patches and their tilings first: every hypothesis, corner or
+  // face, is checked against the layer its face lies on.
+  FaceProposals faces;
+  if (options.face_proposals) {
+    const Clock::time_point t_faces = Clock::now();
+    faces = ProposeFromFaces(depth, options.box, options.faces);
+    det.timings.faces_ms = MsSince(t_faces);
+  }
   internal::HypothesisJudge judge(depth, options);
   for (const Corner& c : det.corners) {
     const EdgeSegment& sa = det.segments[c.segment_a];
@@ -281,6 +289,13 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
                        });
       for (internal::Candidate& c : pending) {
         if (overlaps_kept(c.box.camera_T_box)) continue;
+        if (std::string why = LayerContradiction(faces, depth, options.box, c.box.camera_T_box,
+                                                 c.box.grasp_centre_camera,
+                                                 c.box.grasp_normal_camera, options.faces);
+            !why.empty()) {
+          declined.push_back({c.box.camera_T_box, c.box.score, std::move(why)});
+          continue;
+        }
         det.boxes.push_back(c.box);
         if (options.propagate_to_neighbours) {
           for (const Eigen::Isometry3d& pose :
@@ -296,8 +311,6 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   // Face proposals after the corner ones: a tile on a box already found is
   // not judged again.
   if (options.face_proposals) {
-    const Clock::time_point t_faces = Clock::now();
-    FaceProposals faces = ProposeFromFaces(depth, options.box, options.faces);
     for (const Eigen::Isometry3d& pose : faces.poses) {
       if (!overlaps_kept(pose)) judge.Propose(pose, 0, {}, true);
     }
@@ -305,7 +318,6 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
       d.score = MeasureBox(depth, d.camera_T_box, options.box, options.evidence).support();
       declined.push_back(std::move(d));
     }
-    det.timings.faces_ms = MsSince(t_faces);
     accept_all();
   }
   std::stable_sort(det.boxes.begin(), det.boxes.end(),

@@ -70,12 +70,15 @@ absl::Status FaceProposalOptions::Validate() const {
   if (!(size_tolerance_m > 0.0 && size_tolerance_m <= 0.1) ||
       !(max_gap_m >= 0.0 && max_gap_m <= 0.05) ||
       !(max_view_angle_deg > 0.0 && max_view_angle_deg < 90.0) || max_tiles < 1 ||
-      !(min_seam_support > 0.0 && min_seam_support <= 1.0)) {
+      !(min_seam_support > 0.0 && min_seam_support <= 1.0) ||
+      !(layer_match_m > 0.0 && layer_match_m <= 0.2) ||
+      !(layer_match_deg > 0.0 && layer_match_deg <= 45.0)) {
     return absl::InvalidArgumentError(absl::StrCat(
         "face proposal options out of range: size_tolerance_m=", size_tolerance_m,
         " (0, 0.1], max_gap_m=", max_gap_m, " [0, 0.05], max_view_angle_deg=", max_view_angle_deg,
         " (0, 90), max_tiles=", max_tiles, " >= 1, min_seam_support=", min_seam_support,
-        " (0, 1]"));
+        " (0, 1], layer_match_m=", layer_match_m, " (0, 0.2], layer_match_deg=", layer_match_deg,
+        " (0, 45]"));
   }
   return absl::OkStatus();
 }
@@ -183,7 +186,8 @@ double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const Fa
 FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
                                const FaceProposalOptions& o) {
   FaceProposals out;
-  const PlanarPatches patches = SegmentPlanarPatches(image, o.patches);
+  out.patches = SegmentPlanarPatches(image, o.patches);
+  const PlanarPatches& patches = out.patches;
   out.num_patches = static_cast<int>(patches.patches.size());
   std::array<double, 3> sorted = {dims.l, dims.b, dims.h};
   std::sort(sorted.begin(), sorted.end());
@@ -224,6 +228,15 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
         if (on_patch(pose, t)) out.poses.push_back(pose);
       }
     };
+    // The tiles a box on this patch may be (every tile of the tilings in
+    // play, on the patch or not: a notch is where a box was taken).
+    auto in_play = [&](std::initializer_list<FaceTiling> in) {
+      LayerTiles layer{static_cast<int>(id), patch.normal, patch.centroid, {}};
+      for (const FaceTiling& t : in) {
+        for (const Eigen::Isometry3d& pose : TilePoses(rect, t, dims)) layer.tiles.push_back(pose);
+      }
+      out.layers.push_back(std::move(layer));
+    };
     const std::vector<FaceTiling> tilings = TilingsOf(rect.width, rect.height, dims, o);
     if (tilings.empty()) {
       // Not a whole number of faces (part of it hidden or out of view): a
@@ -254,6 +267,7 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     }
     if (tilings.size() == 1) {
       propose(tilings[0]);
+      in_play({tilings[0]});
       continue;
     }
     // Several tilings fit: seam cues first, then the fewest boxes.
@@ -274,8 +288,10 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     }
     if (chosen >= 0) {
       propose(tilings[chosen]);
+      in_play({tilings[chosen]});
       continue;
     }
+    in_play({tilings[0], tilings[1]});
     for (size_t i = 0; i < tilings.size() && i < 2; ++i) {
       DeclinedCandidate d;
       d.camera_T_box = TilePoses(rect, tilings[i], dims).front();
@@ -286,6 +302,55 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     }
   }
   return out;
+}
+
+namespace {
+
+// Whether two poses are the same box: centres close, and each axis of `a`
+// parallel to an axis of `b` of the same size (the box's symmetries).
+bool SameBox(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, const BoxDims& dims,
+             double max_distance_m, double max_angle_deg) {
+  if ((a.translation() - b.translation()).norm() > max_distance_m) return false;
+  const double cos_max = std::cos(max_angle_deg * std::numbers::pi / 180.0);
+  for (int i = 0; i < 3; ++i) {
+    bool matched = false;
+    for (int j = 0; j < 3 && !matched; ++j) {
+      matched = std::abs(a.linear().col(i).dot(b.linear().col(j))) >= cos_max &&
+                std::abs(dims[i] - dims[j]) < 1e-4;
+    }
+    if (!matched) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::string LayerContradiction(const FaceProposals& faces, const DepthImage& image,
+                               const BoxDims& dims, const Eigen::Isometry3d& camera_T_box,
+                               const Eigen::Vector3d& face_centre,
+                               const Eigen::Vector3d& face_normal, const FaceProposalOptions& o) {
+  if (!o.check_layer_tiling || faces.layers.empty() || face_centre.z() <= 0.05) return "";
+  const Eigen::Vector2d px = Project(image.camera, face_centre);
+  const int patch = faces.patches.PatchAt(static_cast<int>(std::lround(px.x())),
+                                          static_cast<int>(std::lround(px.y())));
+  if (patch < 0) return "";
+  const double cos_max = std::cos(o.layer_match_deg * std::numbers::pi / 180.0);
+  for (const LayerTiles& layer : faces.layers) {
+    if (layer.patch != patch) continue;
+    // On the patch's plane, facing the same way.
+    if (std::abs(face_normal.dot(layer.normal)) < cos_max ||
+        std::abs((face_centre - layer.centroid).dot(layer.normal)) > o.layer_match_m) {
+      return "";
+    }
+    for (const Eigen::Isometry3d& tile : layer.tiles) {
+      if (SameBox(camera_T_box, tile, dims, o.layer_match_m, o.layer_match_deg)) return "";
+    }
+    return absl::StrFormat(
+        "its face lies on a flat run that tiles with %d box faces, and it is none of them (a "
+        "strip of a face cut by a false seam, or a box turned across a layer)",
+        static_cast<int>(layer.tiles.size()));
+  }
+  return "";
 }
 
 }  // namespace cornerpose

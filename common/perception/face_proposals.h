@@ -39,6 +39,12 @@ struct FaceProposalOptions {
   // with none). Unitless.
   double min_seam_support = 0.5;
   double seam_support_margin = 0.25;
+  // A hypothesis whose grasp face lies on a patch that tiles (LayerTiles)
+  // must be one of its tiles: centre within layer_match_m, axes within
+  // layer_match_deg and of the same sizes. Off: no such check.
+  bool check_layer_tiling = true;
+  double layer_match_m = 0.04;
+  double layer_match_deg = 15.0;
 
   absl::Status Validate() const;
 };
@@ -76,13 +82,35 @@ std::vector<Eigen::Isometry3d> TilePoses(const PlaneRectangle& rect, const FaceT
 double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const FaceTiling& tiling,
                    const BoxDims& dims, const SeamCueOptions& options);
 
+// A patch whose outline tiles with whole faces of the box: every tile of
+// every tiling still in play (the one chosen, or both of an ambiguous pair).
+struct LayerTiles {
+  int patch = -1;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Isometry3d> tiles;
+};
+
 struct FaceProposals {
   std::vector<Eigen::Isometry3d> poses;
   std::vector<DeclinedCandidate> declined;  // ambiguous tilings
   int num_patches = 0;
+  PlanarPatches patches;
+  std::vector<LayerTiles> layers;
 };
 
 FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
+                               const FaceProposalOptions& options);
+
+// Why a box hypothesis contradicts the layer its grasp face (centre and
+// outward normal, camera frame) lies on: the face is on a patch that tiles,
+// and the box is none of the tiles (a strip of a face cut by a false seam, a
+// box turned across a layer of touching cartons). Empty when it does not,
+// when the face lies on no such patch, or with check_layer_tiling off.
+std::string LayerContradiction(const FaceProposals& faces, const DepthImage& image,
+                               const BoxDims& dims, const Eigen::Isometry3d& camera_T_box,
+                               const Eigen::Vector3d& face_centre,
+                               const Eigen::Vector3d& face_normal,
                                const FaceProposalOptions& options);
 
 }  // namespace cornerpose

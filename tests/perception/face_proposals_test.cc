@@ -255,6 +255,45 @@ TEST(ColourSeamTest, ALabelAcrossTheLineDoesNotMakeASeam) {
   EXPECT_FALSE(CueAtMiddle(f).seam);
 }
 
+// A hypothesis on a layer that tiles must be one of its tiles: a tile
+// passes, a box turned across the layer (a strip cut off by a false seam,
+// as a Kinect frame of a touching column showed in the simulated cell) or
+// shifted by half a box is declined, and so is nothing off the layer.
+TEST(LayerContradictionTest, OnlyTheLayersTilesPass) {
+  LayerFrame f;  // 3 x 2 cartons, no seam
+  f.Render();
+  const FaceProposalOptions o;
+  const FaceProposals p = ProposeFromFaces(f.image, kCarton, o);
+  ASSERT_EQ(p.layers.size(), 1u);
+  EXPECT_EQ(p.layers[0].tiles.size(), 6u);
+  const Eigen::Vector3d up(0, 0, -1);  // the faces look at the camera
+  auto face_centre = [](const Eigen::Isometry3d& box) {
+    return Eigen::Vector3d(box.translation() - Eigen::Vector3d(0, 0, 0.075));
+  };
+  for (const Eigen::Isometry3d& tile : p.poses) {
+    EXPECT_EQ(LayerContradiction(p, f.image, kCarton, tile, face_centre(tile), up, o), "");
+  }
+  // Turned by 90 degrees about the normal, anchored on the layer's corner.
+  const Eigen::Isometry3d& first = p.poses.front();
+  Eigen::Isometry3d turned = first;
+  turned.linear() = first.linear() * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+  turned.translation() += first.linear() * Eigen::Vector3d(-0.05, 0.05, 0.0);
+  const std::string why = LayerContradiction(p, f.image, kCarton, turned, face_centre(turned), up, o);
+  EXPECT_NE(why.find("tiles with 6 box faces"), std::string::npos) << why;
+  // Shifted by half a box along its length.
+  Eigen::Isometry3d shifted = first;
+  shifted.translation() += first.linear() * Eigen::Vector3d(0.15, 0.0, 0.0);
+  EXPECT_NE(LayerContradiction(p, f.image, kCarton, shifted, face_centre(shifted), up, o), "");
+  // Off: no check.
+  FaceProposalOptions off = o;
+  off.check_layer_tiling = false;
+  EXPECT_EQ(LayerContradiction(p, f.image, kCarton, turned, face_centre(turned), up, off), "");
+  // A face on the floor is on no tiled patch.
+  Eigen::Isometry3d on_floor = Eigen::Isometry3d::Identity();
+  on_floor.translation() = Eigen::Vector3d(0.6, 0.4, kFloor + 0.075);
+  EXPECT_EQ(LayerContradiction(p, f.image, kCarton, on_floor, face_centre(on_floor), up, o), "");
+}
+
 TEST(FaceProposalOptionsTest, ValidateNamesTheField) {
   FaceProposalOptions o;
   EXPECT_TRUE(o.Validate().ok());
@@ -266,6 +305,9 @@ TEST(FaceProposalOptionsTest, ValidateNamesTheField) {
   o = {};
   o.patches.step_px = 0;
   EXPECT_NE(o.Validate().message().find("step_px=0"), std::string::npos);
+  o = {};
+  o.layer_match_m = 0;
+  EXPECT_NE(o.Validate().message().find("layer_match_m=0"), std::string::npos);
 }
 
 }  // namespace

@@ -32,6 +32,7 @@ ABSL_FLAG(double, gap, 0.003, "Gap between pallet boxes, metres.");
 ABSL_FLAG(uint32_t, seed, 1, "Layout and noise seed.");
 ABSL_FLAG(std::string, sensor, "kinect", "Depth sensor model: kinect or ideal.");
 ABSL_FLAG(std::string, frames_dir, "out/sim/frames", "Where the camera writes its frames.");
+ABSL_FLAG(int, keep_frames, 4, "Frames kept in --frames_dir (the newest); more to look at a run afterwards.");
 ABSL_FLAG(double, camera_max_fps, 10, "Most renders a second (wall); only when the world changed.");
 ABSL_FLAG(double, camera_height, 2.0, "Camera height above the floor, metres.");
 ABSL_FLAG(std::string, host, "127.0.0.1", "Address the emulator listens on.");
@@ -142,6 +143,7 @@ int main(int argc, char** argv) {
   camera_options.directory = absl::GetFlag(FLAGS_frames_dir);
   camera_options.sensor = absl::GetFlag(FLAGS_sensor);
   camera_options.max_fps = absl::GetFlag(FLAGS_camera_max_fps);
+  camera_options.keep_frames = absl::GetFlag(FLAGS_keep_frames);
   camera_options.noise_seed = load.seed * 7919u + 1;
   absl::StatusOr<std::unique_ptr<cell_sim::SimCamera>> camera =
       cell_sim::SimCamera::Start(world.get(), camera_options);
