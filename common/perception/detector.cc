@@ -289,9 +289,18 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
                        });
       for (internal::Candidate& c : pending) {
         if (overlaps_kept(c.box.camera_T_box)) continue;
-        if (std::string why = LayerContradiction(faces, depth, options.box, c.box.camera_T_box,
-                                                 c.box.grasp_centre_camera,
-                                                 c.box.grasp_normal_camera, options.faces);
+        // Only a box that some side's seam (or tiling) bounds: one ended by
+        // depth jumps on every side is measured, whatever patch it is on.
+        const bool bounded_by_seams = std::any_of(
+            c.refinement.sides.begin(), c.refinement.sides.end(), [](SideKind k) {
+              return k == SideKind::kSeam || k == SideKind::kTiled || k == SideKind::kContinues;
+            });
+        if (std::string why = bounded_by_seams ? LayerContradiction(faces, depth, options.box,
+                                                                    c.box.camera_T_box,
+                                                                    c.box.grasp_centre_camera,
+                                                                    c.box.grasp_normal_camera,
+                                                                    options.faces)
+                                               : std::string();
             !why.empty()) {
           declined.push_back({c.box.camera_T_box, c.box.score, std::move(why)});
           continue;

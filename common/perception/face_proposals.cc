@@ -72,13 +72,14 @@ absl::Status FaceProposalOptions::Validate() const {
       !(max_view_angle_deg > 0.0 && max_view_angle_deg < 90.0) || max_tiles < 1 ||
       !(min_seam_support > 0.0 && min_seam_support <= 1.0) ||
       !(layer_match_m > 0.0 && layer_match_m <= 0.2) ||
-      !(layer_match_deg > 0.0 && layer_match_deg <= 45.0)) {
+      !(layer_match_deg > 0.0 && layer_match_deg <= 45.0) ||
+      !(layer_min_fill > 0.0 && layer_min_fill <= 1.0)) {
     return absl::InvalidArgumentError(absl::StrCat(
         "face proposal options out of range: size_tolerance_m=", size_tolerance_m,
         " (0, 0.1], max_gap_m=", max_gap_m, " [0, 0.05], max_view_angle_deg=", max_view_angle_deg,
         " (0, 90), max_tiles=", max_tiles, " >= 1, min_seam_support=", min_seam_support,
         " (0, 1], layer_match_m=", layer_match_m, " (0, 0.2], layer_match_deg=", layer_match_deg,
-        " (0, 45]"));
+        " (0, 45], layer_min_fill=", layer_min_fill, " (0, 1]"));
   }
   return absl::OkStatus();
 }
@@ -231,7 +232,8 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     // The tiles a box on this patch may be (every tile of the tilings in
     // play, on the patch or not: a notch is where a box was taken).
     auto in_play = [&](std::initializer_list<FaceTiling> in) {
-      LayerTiles layer{static_cast<int>(id), patch.normal, patch.centroid, {}};
+      LayerTiles layer{static_cast<int>(id), area / (rect.width * rect.height), patch.normal,
+                       patch.centroid, {}};
       for (const FaceTiling& t : in) {
         for (const Eigen::Isometry3d& pose : TilePoses(rect, t, dims)) layer.tiles.push_back(pose);
       }
@@ -337,6 +339,7 @@ std::string LayerContradiction(const FaceProposals& faces, const DepthImage& ima
   const double cos_max = std::cos(o.layer_match_deg * std::numbers::pi / 180.0);
   for (const LayerTiles& layer : faces.layers) {
     if (layer.patch != patch) continue;
+    if (layer.fill < o.layer_min_fill) return "";
     // On the patch's plane, facing the same way.
     if (std::abs(face_normal.dot(layer.normal)) < cos_max ||
         std::abs((face_centre - layer.centroid).dot(layer.normal)) > o.layer_match_m) {

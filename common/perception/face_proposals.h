@@ -41,10 +41,13 @@ struct FaceProposalOptions {
   double seam_support_margin = 0.25;
   // A hypothesis whose grasp face lies on a patch that tiles (LayerTiles)
   // must be one of its tiles: centre within layer_match_m, axes within
-  // layer_match_deg and of the same sizes. Off: no such check.
+  // layer_match_deg and of the same sizes. Only patches that fill at least
+  // layer_min_fill of their outline rectangle count as layers (two faces
+  // at an angle that happen to share a plane do not). Off: no such check.
   bool check_layer_tiling = true;
   double layer_match_m = 0.04;
   double layer_match_deg = 15.0;
+  double layer_min_fill = 0.85;
 
   absl::Status Validate() const;
 };
@@ -86,6 +89,7 @@ double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const Fa
 // every tiling still in play (the one chosen, or both of an ambiguous pair).
 struct LayerTiles {
   int patch = -1;
+  double fill = 0.0;  // the patch's area over its outline rectangle's
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   std::vector<Eigen::Isometry3d> tiles;
@@ -103,7 +107,8 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
                                const FaceProposalOptions& options);
 
 // Why a box hypothesis contradicts the layer its grasp face (centre and
-// outward normal, camera frame) lies on: the face is on a patch that tiles,
+// outward normal, camera frame) lies on (the detector asks it of boxes that
+// a seam, a tiling or a continuing side bounds somewhere): the face is on a patch that tiles,
 // and the box is none of the tiles (a strip of a face cut by a false seam, a
 // box turned across a layer of touching cartons). Empty when it does not,
 // when the face lies on no such patch, or with check_layer_tiling off.
