@@ -325,6 +325,14 @@ std::optional<CellController::PreparedPick> CellController::PreparePick(const Fr
   // saying which) is refused.
   const BoxDims dims = options_.perception.box;
   const std::string frame_name = absl::StrCat(frame.source, "#", frame.frame_id);
+  // A replay's boxes may not be there: only when allowed, or in a dry run.
+  if (!frame.source_live && !options_.perception.allow_replay && !options_.dry_run) {
+    SetState(CellState::kStopped,
+             absl::StrCat(frame_name, ": refused: source '", frame.source,
+                          "' is a replay of recorded frames, not a live camera (set "
+                          "perception.allow_replay to pick from it, or dry_run)"));
+    return std::nullopt;
+  }
   if (!frame.box_dims || ((frame.box_dims->vec() - dims.vec()).cwiseAbs().maxCoeff() > 5e-4)) {
     const std::string used =
         frame.box_dims ? absl::StrCat(frame.box_dims->l, " x ", frame.box_dims->b, " x ",

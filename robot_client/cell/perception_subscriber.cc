@@ -143,8 +143,10 @@ void PerceptionSubscriber::Run() {
                           ? std::optional<BoxDims>(wire::BoxDimsFromProto(response.box_dims_used()))
                           : std::nullopt,
           .source = response.source(),
+          .source_live = response.source_live(),
           .frame_id = response.frame_id(),
           .capture_time = absl::FromUnixNanos(response.capture_time_unix_nanos()),
+          .device_timestamp_us = response.device_timestamp_us(),
           .stream = stream,
           .received = absl::Now()};
       connected_ = true;

@@ -57,8 +57,13 @@ struct FrameDetection {
   // from a server that does not say.
   std::optional<BoxDims> box_dims;
   std::string source;
+  // Whether the source is a camera seeing the scene now; false from a
+  // replay (or a server that does not say): see allow_replay.
+  bool source_live = false;
   uint64_t frame_id = 0;
   absl::Time capture_time;
+  // The device's own time of the frame, microseconds (0 when not given).
+  uint64_t device_timestamp_us = 0;
   // Which stream delivered it (one per (re)opened subscription; frame ids
   // are ordered within one) and when it arrived here.
   uint64_t stream = 0;

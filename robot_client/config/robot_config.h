@@ -42,6 +42,10 @@ struct PerceptionClientOptions {
   std::string tls_cert;
   std::string tls_key;
   std::string tls_server_name;
+  // Pick from a replay of recorded frames (a source that is not live): its
+  // boxes may not be there. Off: such frames are refused (STOPPED, with the
+  // reason) unless dry_run. The emulator cell of the demo sets it.
+  bool allow_replay = false;
 };
 
 struct RobotConnectionOptions {

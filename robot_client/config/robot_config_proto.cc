@@ -51,6 +51,7 @@ absl::Status PerceptionFromProto(const v1::PerceptionClientConfig& perception,
     p->reconnect_initial_s = perception.reconnect_initial_s();
   }
   if (perception.has_reconnect_max_s()) p->reconnect_max_s = perception.reconnect_max_s();
+  p->allow_replay = perception.allow_replay();
   return absl::OkStatus();
 }
 

@@ -14,6 +14,8 @@ v1::DetectResponse MakeDetectResponse(const Detection& detection, const Detector
   response.set_frame_id(frame->id);
   response.set_capture_time_unix_nanos(absl::ToUnixNanos(frame->capture_time));
   response.set_source(frame->source);
+  response.set_source_live(frame->live);
+  response.set_device_timestamp_us(frame->device_timestamp_us);
   if (contents.include_cloud) *response.mutable_cloud() = wire::CloudToProto(frame->cloud);
   return response;
 }

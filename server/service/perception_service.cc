@@ -165,6 +165,7 @@ grpc::ServerUnaryReactor* PerceptionServiceImpl::ListSources(
     const SourceStatus status = source->state();
     out->set_state(ToProto(status.state));
     out->set_state_reason(status.reason);
+    out->set_live(source->live());
   }
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   reactor->Finish(grpc::Status::OK);

@@ -158,6 +158,9 @@ void DirectorySource::Run() {
       frame.id = next_id++;
       frame.capture_time = absl::Now();
       frame.source = name_;
+      frame.live = false;
+      frame.device_timestamp_us = static_cast<uint64_t>(
+          std::llround(static_cast<double>(frame.id - 1) * 1e6 / options_.fps));
       frames_.Publish(std::move(frame));
       if (!frames_.SleepFor(period)) return;
     }

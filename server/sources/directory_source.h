@@ -42,6 +42,8 @@ class DirectorySource final : public FrameSource {
   std::string description() const override { return directory_; }
   absl::StatusOr<Frame> GrabNewerThan(uint64_t last_id, absl::Duration timeout) override;
   SourceStatus state() const override;
+  // Recorded frames: always a replay.
+  bool live() const override { return false; }
 
  private:
   void Run();

@@ -22,8 +22,15 @@ struct Frame {
   // Increasing per source, from 1; a gap means frames were dropped.
   uint64_t id = 0;
   absl::Time capture_time;
+  // The device's own time of the frame, microseconds from an arbitrary
+  // start (OpenNI2's per-frame timestamp; a frame directory's is the frame's
+  // index over its rate). Increasing within one pass of a recording.
+  uint64_t device_timestamp_us = 0;
   // The name of the source.
   std::string source;
+  // A camera seeing the scene now (true), or a replay of recorded frames
+  // (.oni files, frame directories): what is in it may not be there.
+  bool live = false;
 };
 
 enum class SourceState { kStarting, kRunning, kFailed, kFinished };
@@ -53,6 +60,9 @@ class FrameSource {
   virtual absl::StatusOr<Frame> GrabNewerThan(uint64_t last_id, absl::Duration timeout) = 0;
 
   virtual SourceStatus state() const = 0;
+
+  // Whether its frames come from a camera seeing the scene now (Frame::live).
+  virtual bool live() const = 0;
 };
 
 // "STARTING", "RUNNING", "FAILED", "FINISHED".

@@ -136,6 +136,7 @@ void OpenNi2Source::Publish(Frame frame) {
   frame.id = next_id_++;
   frame.capture_time = absl::Now();
   frame.source = name_;
+  frame.live = live();
   frames_.Publish(std::move(frame));
   delivered_ = true;
 }
@@ -240,6 +241,7 @@ OpenNi2Source::SessionEnd OpenNi2Source::Capture(std::string* reason) {
       *reason = std::string(frame.status().message());
       return SessionEnd::kFailed;
     }
+    frame->device_timestamp_us = ref.getTimestamp();
     Publish(*std::move(frame));
     if (play_once && frame_count > 0 && ref.getFrameIndex() >= frame_count) {
       return SessionEnd::kFinished;

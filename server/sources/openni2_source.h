@@ -56,6 +56,9 @@ class OpenNi2Source final : public FrameSource {
   std::string description() const override;
   absl::StatusOr<Frame> GrabNewerThan(uint64_t last_id, absl::Duration timeout) override;
   SourceStatus state() const override;
+  // A device (the virtual camera included: it renders the world as it is);
+  // an .oni recording is a replay.
+  bool live() const override { return !options_.recording; }
 
  private:
   // What ended a capture session.

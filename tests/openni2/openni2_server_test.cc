@@ -66,8 +66,10 @@ TEST_F(OpenNi2ServerTest, ListsOpenNi2SourcesWithTheirState) {
   const v1::Source rec = WaitForSource("rec");
   EXPECT_EQ(rec.description(), "oni:" + *recording_);
   EXPECT_EQ(rec.state(), v1::SOURCE_STATE_RUNNING) << rec.state_reason();
+  EXPECT_FALSE(rec.live());  // an .oni recording is a replay
   const v1::Source cam = WaitForSource("cam");
   EXPECT_EQ(cam.state(), v1::SOURCE_STATE_RUNNING) << cam.state_reason();
+  EXPECT_TRUE(cam.live());  // a device (the virtual camera) is live
 
   const v1::Source gone = WaitForSource("gone");
   EXPECT_EQ(gone.state(), v1::SOURCE_STATE_FAILED);
@@ -87,6 +89,14 @@ TEST_F(OpenNi2ServerTest, DetectOnOpenNi2SourcesFindsBoxesAndFailedOnesAreUnavai
     EXPECT_EQ(response.source(), name);
     EXPECT_GT(response.frame_id(), 0u);
     EXPECT_GT(response.boxes_size(), 0) << name;
+    EXPECT_EQ(response.source_live(), name == "cam");
+    // The device's own frame time comes through (the driver's: index / fps).
+    v1::DetectResponse later;
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    ASSERT_TRUE(DetectOn(name, &later).ok());
+    if (later.frame_id() > response.frame_id()) {
+      EXPECT_GT(later.device_timestamp_us(), response.device_timestamp_us()) << name;
+    }
   }
   WaitForSource("gone");
   v1::DetectResponse response;

@@ -211,6 +211,37 @@ TEST_F(CellFaultTest, NoBringUpAtStartUnlessConfigured) {
   ASSERT_TRUE(WaitFinished(&status)) << status.DebugString();
 }
 
+// Recorded frames are a replay: without allow_replay (and not a dry run)
+// the cell refuses them, names the source, and sends the arm nothing.
+TEST_F(CellFaultTest, ReplaySourceIsRefusedUnlessAllowed) {
+  options_.max_picks = 1;
+  options_.perception.allow_replay = false;
+  StartCell();
+  v1::CellStatus status;
+  ASSERT_TRUE(WaitForState(v1::CELL_STATE_STOPPED, "'cell' is a replay", absl::Seconds(30),
+                           &status))
+      << status.DebugString();
+  EXPECT_TRUE(NoProgramSentFor(absl::Seconds(2)));
+  EXPECT_EQ(status.picks_done(), 0u);
+}
+
+// The server detected with other dimensions than the cell plans for (here
+// the subscription asks for another size): every frame is refused, the
+// reason names both sizes, and no program is sent.
+TEST_F(CellFaultTest, DetectionsOfAnotherBoxSizeAreRefused) {
+  options_.max_picks = 1;
+  subscribed_box_ = BoxDims{0.32, 0.20, 0.15};
+  StartCell();
+  v1::CellStatus status;
+  ASSERT_TRUE(WaitForState(v1::CELL_STATE_STOPPED, "not the configured 0.3 x 0.2 x 0.15 m",
+                           absl::Seconds(30), &status))
+      << status.DebugString();
+  EXPECT_NE(status.stop_reason().find("0.32 x 0.2 x 0.15 m"), std::string::npos)
+      << status.stop_reason();
+  EXPECT_TRUE(NoProgramSentFor(absl::Seconds(2)));
+  EXPECT_EQ(status.picks_done(), 0u);
+}
+
 // The real daemon binary: SIGTERM mid-pick stops the arm's program and
 // exits 0 well inside the systemd unit's TimeoutStopSec (20 s).
 TEST_F(CellFaultTest, SigtermMidPickStopsTheProgramAndExits) {

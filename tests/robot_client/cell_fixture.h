@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -61,6 +62,8 @@ class CellFixture : public ::testing::Test {
     options_ = *std::move(options);
     options_.perception.server_address = "127.0.0.1:" + std::to_string(server_->port());
     options_.perception.source = "cell";
+    // The recorded frames are a replay; these tests drive the emulator.
+    options_.perception.allow_replay = true;
     options_.robot.host = "127.0.0.1";
     options_.robot.dashboard_port = emulator_->dashboard_port();
     options_.robot.primary_port = emulator_->primary_port();
@@ -80,13 +83,17 @@ class CellFixture : public ::testing::Test {
     subscriber_.reset();
   }
 
+  // Set: the subscription asks the server for this box size instead of the
+  // one the cell plans for (a server and a daemon that disagree).
+  std::optional<BoxDims> subscribed_box_;
+
   // Starts the daemon's parts as cornerpose_robot_client does.
   void StartCell() {
     PerceptionSubscriberOptions perception;
     perception.server = options_.perception.server_address;
     perception.source = options_.perception.source;
     perception.box_model = options_.perception.box_model;
-    perception.box = options_.perception.box;
+    perception.box = subscribed_box_.value_or(options_.perception.box);
     perception.initial_backoff = absl::Milliseconds(100);
     perception.max_backoff = absl::Milliseconds(500);
     subscriber_ = std::make_unique<PerceptionSubscriber>(perception);

@@ -32,6 +32,7 @@ TEST_F(SourceServerTest, ListsSourcesWithTheirState) {
   const v1::Source bin = WaitForSource("bin");
   EXPECT_EQ(bin.description(), kCartonFrames);
   EXPECT_EQ(bin.state(), v1::SOURCE_STATE_RUNNING) << bin.state_reason();
+  EXPECT_FALSE(bin.live());  // recorded frames are a replay
 
   const v1::Source broken = WaitForSource("broken");
   EXPECT_EQ(broken.description(), "/nonexistent/frames");
@@ -48,6 +49,9 @@ TEST_F(SourceServerTest, DetectOnASourceFindsBoxesInItsNewestFrame) {
   EXPECT_EQ(first.source(), "bin");
   EXPECT_GT(first.frame_id(), 0u);
   EXPECT_GT(first.capture_time_unix_nanos(), 0);
+  EXPECT_FALSE(first.source_live());
+  // A frame directory's device time is its frame index over its rate.
+  EXPECT_EQ(first.device_timestamp_us(), (first.frame_id() - 1) * 200000u);
 
   // At 5 fps a later request sees a later frame.
   std::this_thread::sleep_for(std::chrono::milliseconds(400));
@@ -55,6 +59,7 @@ TEST_F(SourceServerTest, DetectOnASourceFindsBoxesInItsNewestFrame) {
   s = DetectOn("bin", &second);
   ASSERT_TRUE(s.ok()) << s.error_message();
   EXPECT_GT(second.frame_id(), first.frame_id());
+  EXPECT_GT(second.device_timestamp_us(), first.device_timestamp_us());
   EXPECT_GE(second.capture_time_unix_nanos(), first.capture_time_unix_nanos());
 }
 
