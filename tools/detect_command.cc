@@ -55,8 +55,10 @@ constexpr char kHelp[] =
     "  --threads N          worker threads (2)\n"
     "  --faces BOOL         face-first proposals from planar patches (true); false is\n"
     "                       the corner-only detector\n"
-    "  --layer_check BOOL   a box whose face lies on a flat run that tiles must be one\n"
+    "  --layer_check BOOL   a box that a seam bounds on a layer that tiles must be one\n"
     "                       of its tiles (true)\n"
+    "  --floor_check BOOL   no box reaches through the floor, the farthest large plane\n"
+    "                       (true)\n"
     "  --size_tolerance M   how far a box may be off its nominal size and still be it\n"
     "                       (unset: each stage's own tolerance, 1-2.5 cm)\n"
     "  --kdtree             unorganized clouds: score edges over a k-d tree (the\n"
@@ -88,7 +90,8 @@ absl::Status Run(const CommandArgs& args) {
                          args.SetInt("coarse_step", &options.edge_points.coarse_step),
                          args.SetBool("denoise", &options.edge_points.denoise),
                          args.SetBool("faces", &options.face_proposals),
-                         args.SetBool("layer_check", &options.faces.check_layer_tiling)}) {
+                         args.SetBool("layer_check", &options.faces.check_layer_tiling),
+                         args.SetBool("floor_check", &options.floor_check)}) {
     if (!s.ok()) return s;
   }
   if (get("size_tolerance")) {
@@ -160,7 +163,7 @@ int RunDetect(const std::vector<std::string>& argv) {
       argv,
       {"cloud", "box", "intrinsics", "json", "ply", "png", "edges", "radius", "threshold",
        "samples", "ransac_threshold", "meet_distance", "threads", "coarse_step", "denoise",
-       "color", "faces", "layer_check", "size_tolerance"},
+       "color", "faces", "layer_check", "floor_check", "size_tolerance"},
       {"quiet", "kdtree"});
   if (!args.ok()) {
     std::fprintf(stderr, "cornerpose detect: %s\n\n%s",

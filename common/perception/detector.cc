@@ -1,12 +1,14 @@
 #include "common/perception/detector.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "common/perception/camera_model.h"
 #include "common/perception/internal/box_overlap.h"
 #include "common/perception/internal/hypothesis_judge.h"
@@ -60,6 +62,129 @@ void ApplySizeTolerance(double t, DetectorOptions* o) {
   o->refinement.tile_tolerance_m = 2.0 * t / 3.0;
   o->pose.length_tolerance_m = t + 0.01;
   o->acceptance.extent_tolerance_m = t + 0.01;
+}
+
+// A box cannot reach through the floor. The floor is the farthest large
+// plane the camera sees (a planar patch of at least floor_min_area_m2, and
+// three of the box's largest faces, whose plane lies farthest from the
+// camera along its normal: the floor or table under a pallet, a heap or a
+// bin), with no more than 1 % of the frame beyond it. A box with a corner more than floor_tolerance_m beyond it is taken
+// out: a "box" whose face is a pallet's deck board reaches its own height
+// into the floor. True when a box was taken out.
+bool CheckFloor(const DepthImage& depth, const DetectorOptions& options,
+                const FaceProposals& faces, std::vector<DetectedBox>* boxes,
+                std::vector<std::array<SideKind, 4>>* sides,
+                std::vector<DeclinedCandidate>* declined) {
+  const BoxDims& d = options.box;
+  const double largest_face = std::max({d.l * d.b, d.l * d.h, d.b * d.h});
+  const double min_area = std::max(options.floor_min_area_m2, 3.0 * largest_face);
+  const PlanarPatch* floor = nullptr;
+  double floor_distance = 0.0;
+  for (const PlanarPatch& patch : faces.patches.patches) {
+    const double cell_m = patch.centroid.z() / depth.camera.fx * faces.patches.step_px;
+    if (patch.points.size() * cell_m * cell_m < min_area) continue;
+    // The normal points at the camera, so the plane is n.x = -distance.
+    const double distance = -patch.normal.dot(patch.centroid);
+    if (distance > floor_distance) {
+      floor_distance = distance;
+      floor = &patch;
+    }
+  }
+  if (floor == nullptr) return false;
+  // It is the floor only when nothing lies beyond it: a lower layer's top
+  // or a pallet deck may be the farthest plane found while the floor itself
+  // (noisy, or cut up) is no patch.
+  int seen = 0, beyond = 0;
+  for (int v = 0; v < depth.camera.height; v += 4) {
+    for (int u = 0; u < depth.camera.width; u += 4) {
+      const float z = depth.at(u, v);
+      if (std::isnan(z)) continue;
+      ++seen;
+      const Eigen::Vector3d p = z * PixelRay(depth.camera, u, v);
+      beyond += -floor->normal.dot(p - floor->centroid) > options.floor_tolerance_m;
+    }
+  }
+  if (seen == 0 || beyond > 0.01 * seen) return false;
+  bool removed = false;
+  size_t kept = 0;
+  for (size_t i = 0; i < boxes->size(); ++i) {
+    const Eigen::Isometry3d& pose = (*boxes)[i].camera_T_box;
+    double deepest = -std::numeric_limits<double>::max();
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner =
+          pose * Eigen::Vector3d((c & 1 ? 0.5 : -0.5) * d.l, (c & 2 ? 0.5 : -0.5) * d.b,
+                                 (c & 4 ? 0.5 : -0.5) * d.h);
+      // How far beyond the floor, away from the camera.
+      deepest = std::max(deepest, -floor->normal.dot(corner - floor->centroid));
+    }
+    if (deepest > options.floor_tolerance_m) {
+      declined->push_back({pose, (*boxes)[i].score,
+                           absl::StrFormat("the box would reach %.0f mm into the floor (a "
+                                           "flat piece of something else of a face's size)",
+                                           1000.0 * deepest)});
+      removed = true;
+      continue;
+    }
+    (*boxes)[kept] = (*boxes)[i];
+    (*sides)[kept] = (*sides)[i];
+    ++kept;
+  }
+  boxes->resize(kept);
+  sides->resize(kept);
+  return removed;
+}
+
+// The layer check (FaceProposalOptions::check_layer_tiling). A layer is
+// trusted when a box ended by depth jumps on both axes of its face (a free
+// side along each) is one of its tiles; on a trusted layer, a box that a
+// seam, a tiling or a continuing side bounds and that is none of its tiles
+// is taken out (a false seam in the middle of a face otherwise makes a
+// box-wide strip of it: in the simulated cell such a box was picked 7 cm off
+// its centre and hit the robot's pedestal). A layer nothing anchors (its
+// outline may tile by chance, with boxes of another size in it) decides
+// nothing. True when a box was taken out.
+bool CheckLayers(const DepthImage& depth, const DetectorOptions& options,
+                 const FaceProposals& faces, std::vector<DetectedBox>* boxes,
+                 std::vector<std::array<SideKind, 4>>* sides,
+                 std::vector<DeclinedCandidate>* declined) {
+  const size_t n = boxes->size();
+  std::vector<int> layer(n, -1);
+  std::vector<bool> trusted(faces.layers.size(), false);
+  std::vector<bool> tile(n, false);
+  for (size_t i = 0; i < n; ++i) {
+    const DetectedBox& b = (*boxes)[i];
+    layer[i] = LayerUnder(faces, depth, b.grasp_centre_camera, b.grasp_normal_camera, options.faces);
+    if (layer[i] < 0) continue;
+    tile[i] = IsLayerTile(faces.layers[layer[i]], options.box, b.camera_T_box, options.faces);
+    const std::array<SideKind, 4>& s = (*sides)[i];
+    const bool free_a = s[0] == SideKind::kFree || s[1] == SideKind::kFree;
+    const bool free_b = s[2] == SideKind::kFree || s[3] == SideKind::kFree;
+    if (tile[i] && free_a && free_b) trusted[layer[i]] = true;
+  }
+  bool removed = false;
+  size_t kept = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const std::array<SideKind, 4>& s = (*sides)[i];
+    const bool bounded_by_seams = std::any_of(s.begin(), s.end(), [](SideKind k) {
+      return k == SideKind::kSeam || k == SideKind::kTiled || k == SideKind::kContinues;
+    });
+    if (layer[i] >= 0 && trusted[layer[i]] && !tile[i] && bounded_by_seams) {
+      declined->push_back(
+          {(*boxes)[i].camera_T_box, (*boxes)[i].score,
+           absl::StrFormat("its face lies on a layer that tiles with %d box faces (a box ended by "
+                           "depth jumps is one of them) and it is none of them: a strip of a face "
+                           "cut by a false seam, or a box turned across the layer",
+                           static_cast<int>(faces.layers[layer[i]].tiles.size()))});
+      removed = true;
+      continue;
+    }
+    (*boxes)[kept] = (*boxes)[i];
+    (*sides)[kept] = (*sides)[i];
+    ++kept;
+  }
+  boxes->resize(kept);
+  sides->resize(kept);
+  return removed;
 }
 
 // The strongest declined hypotheses: none that overlaps a returned box (a
@@ -136,6 +261,14 @@ absl::Status DetectorOptions::Validate() const {
        {edge_points.Validate(), segments.Validate(), clubbing.Validate(), pose.Validate(),
         refinement.Validate(), evidence.Validate(), acceptance.Validate(), faces.Validate()}) {
     if (!s.ok()) return s;
+  }
+  if (!(floor_tolerance_m > 0.0 && floor_tolerance_m <= 0.5)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("floor_tolerance_m=", floor_tolerance_m, " is outside (0, 0.5]"));
+  }
+  if (!(floor_min_area_m2 > 0.0 && floor_min_area_m2 <= 100.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("floor_min_area_m2=", floor_min_area_m2, " is outside (0, 100]"));
   }
   if (size_tolerance_m && !(*size_tolerance_m > 0.0 && *size_tolerance_m <= 0.1)) {
     return absl::InvalidArgumentError(
@@ -256,6 +389,7 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
     det.timings.faces_ms = MsSince(t_faces);
   }
   internal::HypothesisJudge judge(depth, options);
+  std::vector<std::array<SideKind, 4>> sides_of;  // per det.boxes entry
   for (const Corner& c : det.corners) {
     const EdgeSegment& sa = det.segments[c.segment_a];
     const EdgeSegment& sb = det.segments[c.segment_b];
@@ -289,23 +423,8 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
                        });
       for (internal::Candidate& c : pending) {
         if (overlaps_kept(c.box.camera_T_box)) continue;
-        // Only a box that some side's seam (or tiling) bounds: one ended by
-        // depth jumps on every side is measured, whatever patch it is on.
-        const bool bounded_by_seams = std::any_of(
-            c.refinement.sides.begin(), c.refinement.sides.end(), [](SideKind k) {
-              return k == SideKind::kSeam || k == SideKind::kTiled || k == SideKind::kContinues;
-            });
-        if (std::string why = bounded_by_seams ? LayerContradiction(faces, depth, options.box,
-                                                                    c.box.camera_T_box,
-                                                                    c.box.grasp_centre_camera,
-                                                                    c.box.grasp_normal_camera,
-                                                                    options.faces)
-                                               : std::string();
-            !why.empty()) {
-          declined.push_back({c.box.camera_T_box, c.box.score, std::move(why)});
-          continue;
-        }
         det.boxes.push_back(c.box);
+        sides_of.push_back(c.refinement.sides);
         if (options.propagate_to_neighbours) {
           for (const Eigen::Isometry3d& pose :
                NeighbourHypotheses(c.box, options.box, options.neighbour_gap_m)) {
@@ -328,6 +447,26 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
       declined.push_back(std::move(d));
     }
     accept_all();
+    // Plausibility checks; where they took a box out, the layers' own tiles
+    // get their turn, and what that accepts is checked again (a few rounds,
+    // then a last check with nothing proposed).
+    auto check = [&] {
+      const bool floor_removed = options.floor_check && CheckFloor(depth, options, faces,
+                                                                   &det.boxes, &sides_of, &declined);
+      const bool layer_removed =
+          options.faces.check_layer_tiling &&
+          CheckLayers(depth, options, faces, &det.boxes, &sides_of, &declined);
+      return floor_removed || layer_removed;
+    };
+    for (int round = 0; round < 3 && check(); ++round) {
+      for (const LayerTiles& layer : faces.layers) {
+        for (const Eigen::Isometry3d& tile : layer.tiles) {
+          if (!overlaps_kept(tile)) judge.Propose(tile, 0, {}, true);
+        }
+      }
+      accept_all();
+    }
+    check();
   }
   std::stable_sort(det.boxes.begin(), det.boxes.end(),
                    [](const DetectedBox& a, const DetectedBox& b) { return a.score > b.score; });

@@ -69,6 +69,13 @@ struct DetectorOptions {
   // with the corner ones. False gives the corner-only detector.
   bool face_proposals = true;
   FaceProposalOptions faces;
+  // With face proposals: no box reaches more than floor_tolerance_m through
+  // the floor, the farthest planar patch of at least floor_min_area_m2 (and
+  // three of the box's largest faces) the camera sees (detector.cc,
+  // CheckFloor). Metres, square metres.
+  bool floor_check = true;
+  double floor_tolerance_m = 0.03;
+  double floor_min_area_m2 = 0.25;
   // How far a real box may be off its nominal size (bulge, sag, crushed
   // corners) and still be the box. Unset keeps each stage's own tolerance
   // (pose.length_tolerance_m 0.025, acceptance.extent_tolerance_m 0.025,

@@ -1,6 +1,7 @@
 #include "common/perception/face_proposals.h"
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <numbers>
 
@@ -232,10 +233,19 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     // The tiles a box on this patch may be (every tile of the tilings in
     // play, on the patch or not: a notch is where a box was taken).
     auto in_play = [&](std::initializer_list<FaceTiling> in) {
-      LayerTiles layer{static_cast<int>(id), area / (rect.width * rect.height), patch.normal,
+      // Fill: the patch's area over that of the tiles on it (a layer with
+      // boxes taken away is still full where it is); the least of the
+      // tilings in play.
+      LayerTiles layer{static_cast<int>(id), std::numeric_limits<double>::max(), patch.normal,
                        patch.centroid, {}};
       for (const FaceTiling& t : in) {
-        for (const Eigen::Isometry3d& pose : TilePoses(rect, t, dims)) layer.tiles.push_back(pose);
+        int present = 0;
+        for (const Eigen::Isometry3d& pose : TilePoses(rect, t, dims)) {
+          layer.tiles.push_back(pose);
+          present += on_patch(pose, t);
+        }
+        const double tile_area = dims[t.axis_u] * dims[t.axis_v];
+        layer.fill = std::min(layer.fill, present > 0 ? area / (present * tile_area) : 0.0);
       }
       out.layers.push_back(std::move(layer));
     };
@@ -327,33 +337,33 @@ bool SameBox(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, const BoxDi
 
 }  // namespace
 
-std::string LayerContradiction(const FaceProposals& faces, const DepthImage& image,
-                               const BoxDims& dims, const Eigen::Isometry3d& camera_T_box,
-                               const Eigen::Vector3d& face_centre,
-                               const Eigen::Vector3d& face_normal, const FaceProposalOptions& o) {
-  if (!o.check_layer_tiling || faces.layers.empty() || face_centre.z() <= 0.05) return "";
+int LayerUnder(const FaceProposals& faces, const DepthImage& image,
+               const Eigen::Vector3d& face_centre, const Eigen::Vector3d& face_normal,
+               const FaceProposalOptions& o) {
+  if (faces.layers.empty() || face_centre.z() <= 0.05) return -1;
   const Eigen::Vector2d px = Project(image.camera, face_centre);
   const int patch = faces.patches.PatchAt(static_cast<int>(std::lround(px.x())),
                                           static_cast<int>(std::lround(px.y())));
-  if (patch < 0) return "";
+  if (patch < 0) return -1;
   const double cos_max = std::cos(o.layer_match_deg * std::numbers::pi / 180.0);
-  for (const LayerTiles& layer : faces.layers) {
+  for (size_t i = 0; i < faces.layers.size(); ++i) {
+    const LayerTiles& layer = faces.layers[i];
     if (layer.patch != patch) continue;
-    if (layer.fill < o.layer_min_fill) return "";
-    // On the patch's plane, facing the same way.
-    if (std::abs(face_normal.dot(layer.normal)) < cos_max ||
+    if (layer.fill < o.layer_min_fill ||
+        std::abs(face_normal.dot(layer.normal)) < cos_max ||
         std::abs((face_centre - layer.centroid).dot(layer.normal)) > o.layer_match_m) {
-      return "";
+      return -1;
     }
-    for (const Eigen::Isometry3d& tile : layer.tiles) {
-      if (SameBox(camera_T_box, tile, dims, o.layer_match_m, o.layer_match_deg)) return "";
-    }
-    return absl::StrFormat(
-        "its face lies on a flat run that tiles with %d box faces, and it is none of them (a "
-        "strip of a face cut by a false seam, or a box turned across a layer)",
-        static_cast<int>(layer.tiles.size()));
+    return static_cast<int>(i);
   }
-  return "";
+  return -1;
+}
+
+bool IsLayerTile(const LayerTiles& layer, const BoxDims& dims,
+                 const Eigen::Isometry3d& camera_T_box, const FaceProposalOptions& o) {
+  return std::any_of(layer.tiles.begin(), layer.tiles.end(), [&](const Eigen::Isometry3d& tile) {
+    return SameBox(camera_T_box, tile, dims, o.layer_match_m, o.layer_match_deg);
+  });
 }
 
 }  // namespace cornerpose

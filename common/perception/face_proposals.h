@@ -39,15 +39,18 @@ struct FaceProposalOptions {
   // with none). Unitless.
   double min_seam_support = 0.5;
   double seam_support_margin = 0.25;
-  // A hypothesis whose grasp face lies on a patch that tiles (LayerTiles)
-  // must be one of its tiles: centre within layer_match_m, axes within
-  // layer_match_deg and of the same sizes. Only patches that fill at least
-  // layer_min_fill of their outline rectangle count as layers (two faces
-  // at an angle that happen to share a plane do not). Off: no such check.
+  // The layer check (detector.cc, CheckLayers): a layer (a patch that
+  // tiles, LayerTiles) is trusted when a box ended by depth jumps on both of
+  // its face's axes is one of its tiles (an outline that takes in a box of
+  // another size may tile by chance; then no box found is one of its tiles);
+  // on a trusted layer a box that a seam bounds must be one of its tiles
+  // too. Tiles match with the centre within layer_match_m and the axes within
+  // layer_match_deg (of the same sizes); a patch filling less than
+  // layer_min_fill of the tiles on it is no layer. Off: no such check.
   bool check_layer_tiling = true;
   double layer_match_m = 0.04;
   double layer_match_deg = 15.0;
-  double layer_min_fill = 0.85;
+  double layer_min_fill = 0.7;
 
   absl::Status Validate() const;
 };
@@ -89,7 +92,9 @@ double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const Fa
 // every tiling still in play (the one chosen, or both of an ambiguous pair).
 struct LayerTiles {
   int patch = -1;
-  double fill = 0.0;  // the patch's area over its outline rectangle's
+  // The patch's area over that of the tiles on it (the least over the
+  // tilings in play): about 1 for a layer, notched or not.
+  double fill = 0.0;
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   std::vector<Eigen::Isometry3d> tiles;
@@ -106,16 +111,16 @@ struct FaceProposals {
 FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
                                const FaceProposalOptions& options);
 
-// Why a box hypothesis contradicts the layer its grasp face (centre and
-// outward normal, camera frame) lies on (the detector asks it of boxes that
-// a seam, a tiling or a continuing side bounds somewhere): the face is on a patch that tiles,
-// and the box is none of the tiles (a strip of a face cut by a false seam, a
-// box turned across a layer of touching cartons). Empty when it does not,
-// when the face lies on no such patch, or with check_layer_tiling off.
-std::string LayerContradiction(const FaceProposals& faces, const DepthImage& image,
-                               const BoxDims& dims, const Eigen::Isometry3d& camera_T_box,
-                               const Eigen::Vector3d& face_centre,
-                               const Eigen::Vector3d& face_normal,
-                               const FaceProposalOptions& options);
+// The layer (an index into faces.layers) a grasp face (centre and outward
+// normal, camera frame) lies on: on its patch, facing its way, on its plane,
+// the patch filling layer_min_fill of its outline. -1 when none.
+int LayerUnder(const FaceProposals& faces, const DepthImage& image,
+               const Eigen::Vector3d& face_centre, const Eigen::Vector3d& face_normal,
+               const FaceProposalOptions& options);
+
+// Whether camera_T_box is one of the layer's tiles (centre within
+// layer_match_m, axes within layer_match_deg and of the same sizes).
+bool IsLayerTile(const LayerTiles& layer, const BoxDims& dims,
+                 const Eigen::Isometry3d& camera_T_box, const FaceProposalOptions& options);
 
 }  // namespace cornerpose

@@ -60,7 +60,7 @@ def clear_protective_stop(out, port, done):
             text = open(log).read()
         except OSError:
             text = ""
-        if "protective stop" in text.lower() and "STOPPED" in text:
+        if re.search(r"(?i)protective[ _]stop", text) and "STOPPED" in text:
             while time.time() < deadline:
                 reply = dashboard(port, "unlock protective stop")
                 print("test: dashboard: unlock protective stop ->", reply, flush=True)
@@ -125,7 +125,7 @@ def main():
     elif case == "protective_stop":
         check("protective stop injected" in open(os.path.join(out, "sim", "cell_sim.log")).read(),
               "no protective stop was injected")
-        check(re.search(r"(?i)protective stop", daemon_log) is not None,
+        check(re.search(r"(?i)protective[ _]stop", daemon_log) is not None,
               "the daemon did not report the stop")
         interrupted = [p for p in failed if p["result"] == "interrupted"]
         check(len(interrupted) == 1 and len(failed) == 1,

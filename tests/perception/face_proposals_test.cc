@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -255,43 +256,45 @@ TEST(ColourSeamTest, ALabelAcrossTheLineDoesNotMakeASeam) {
   EXPECT_FALSE(CueAtMiddle(f).seam);
 }
 
-// A hypothesis on a layer that tiles must be one of its tiles: a tile
-// passes, a box turned across the layer (a strip cut off by a false seam,
-// as a Kinect frame of a touching column showed in the simulated cell) or
-// shifted by half a box is declined, and so is nothing off the layer.
-TEST(LayerContradictionTest, OnlyTheLayersTilesPass) {
+// The layer a face lies on and its tiles: a tile is one, a box turned
+// across the layer (a strip cut off by a false seam, as a Kinect frame of a
+// touching column showed in the simulated cell) or shifted by half a box is
+// none; a face on the floor is on no layer.
+TEST(LayerCheckTest, TheLayerUnderAFaceAndItsTiles) {
   LayerFrame f;  // 3 x 2 cartons, no seam
   f.Render();
-  const FaceProposalOptions o;
+  FaceProposalOptions o;
   const FaceProposals p = ProposeFromFaces(f.image, kCarton, o);
   ASSERT_EQ(p.layers.size(), 1u);
-  EXPECT_EQ(p.layers[0].tiles.size(), 6u);
+  ASSERT_EQ(p.layers[0].tiles.size(), 6u);
+  EXPECT_GT(p.layers[0].fill, 0.9);
+  const LayerTiles& layer = p.layers[0];
   const Eigen::Vector3d up(0, 0, -1);  // the faces look at the camera
   auto face_centre = [](const Eigen::Isometry3d& box) {
     return Eigen::Vector3d(box.translation() - Eigen::Vector3d(0, 0, 0.075));
   };
   for (const Eigen::Isometry3d& tile : p.poses) {
-    EXPECT_EQ(LayerContradiction(p, f.image, kCarton, tile, face_centre(tile), up, o), "");
+    EXPECT_EQ(LayerUnder(p, f.image, face_centre(tile), up, o), 0);
+    EXPECT_TRUE(IsLayerTile(layer, kCarton, tile, o));
   }
   // Turned by 90 degrees about the normal, anchored on the layer's corner.
   const Eigen::Isometry3d& first = p.poses.front();
   Eigen::Isometry3d turned = first;
   turned.linear() = first.linear() * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
   turned.translation() += first.linear() * Eigen::Vector3d(-0.05, 0.05, 0.0);
-  const std::string why = LayerContradiction(p, f.image, kCarton, turned, face_centre(turned), up, o);
-  EXPECT_NE(why.find("tiles with 6 box faces"), std::string::npos) << why;
+  EXPECT_EQ(LayerUnder(p, f.image, face_centre(turned), up, o), 0);
+  EXPECT_FALSE(IsLayerTile(layer, kCarton, turned, o));
   // Shifted by half a box along its length.
   Eigen::Isometry3d shifted = first;
   shifted.translation() += first.linear() * Eigen::Vector3d(0.15, 0.0, 0.0);
-  EXPECT_NE(LayerContradiction(p, f.image, kCarton, shifted, face_centre(shifted), up, o), "");
-  // Off: no check.
-  FaceProposalOptions off = o;
-  off.check_layer_tiling = false;
-  EXPECT_EQ(LayerContradiction(p, f.image, kCarton, turned, face_centre(turned), up, off), "");
-  // A face on the floor is on no tiled patch.
-  Eigen::Isometry3d on_floor = Eigen::Isometry3d::Identity();
-  on_floor.translation() = Eigen::Vector3d(0.6, 0.4, kFloor + 0.075);
-  EXPECT_EQ(LayerContradiction(p, f.image, kCarton, on_floor, face_centre(on_floor), up, o), "");
+  EXPECT_FALSE(IsLayerTile(layer, kCarton, shifted, o));
+  // A face on the floor is on no layer.
+  EXPECT_EQ(LayerUnder(p, f.image, Eigen::Vector3d(0.6, 0.4, kFloor), up, o), -1);
+  // A patch filling less than layer_min_fill of its outline is no layer.
+  o.layer_min_fill = std::min(1.0, layer.fill + 0.05);
+  if (layer.fill < o.layer_min_fill) {
+    EXPECT_EQ(LayerUnder(p, f.image, face_centre(first), up, o), -1);
+  }
 }
 
 TEST(FaceProposalOptionsTest, ValidateNamesTheField) {
