@@ -251,6 +251,16 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     };
     const std::vector<FaceTiling> tilings = TilingsOf(rect.width, rect.height, dims, o);
     if (tilings.empty()) {
+      // For the layer check only (nothing is proposed from it): an outline
+      // a little too big to tile (its rim taken in, noise at a closer
+      // range) still makes a layer with twice the tolerance, when one
+      // tiling has the fewest tiles; an anchor must confirm it (detector).
+      FaceProposalOptions loose = o;
+      loose.size_tolerance_m = 2.0 * o.size_tolerance_m;
+      const std::vector<FaceTiling> near = TilingsOf(rect.width, rect.height, dims, loose);
+      if (near.size() == 1 || (near.size() > 1 && near[0].tiles() < near[1].tiles())) {
+        in_play({near[0]});
+      }
       // Not a whole number of faces (part of it hidden or out of view): a
       // face in each corner of the outline, for each way one fits in it;
       // only for an outline about one face in size (a bigger one is a

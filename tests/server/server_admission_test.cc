@@ -209,11 +209,17 @@ TEST_F(AdmissionTest, IdenticalStreamsShareOneDetectionPerFrame) {
     open->context.TryCancel();
     open->reader->Finish();
   }
-  // 12 responses; unshared that would be 12 detections (and more in flight).
-  // Shared: one per distinct frame, plus at most one in flight per stream.
+  // 12 responses; unshared, every response is its own detection, so a frame
+  // both streams saw is detected twice. Shared: one detection per distinct
+  // frame, plus what was in flight when the streams were cancelled (a
+  // stream's next detection, and the source's newer frame under load).
+  // On a loaded machine the streams may see no frame in common; then there
+  // was nothing to share and only the bound holds.
   EXPECT_EQ(seen_a.size() + seen_b.size(), 2u * kFrames);
-  EXPECT_LE(started, both.size() + 2) << "frames " << both.size();
-  EXPECT_LT(started, 2u * kFrames);
+  EXPECT_LE(started, both.size() + 4) << "frames " << both.size();
+  if (both.size() <= kFrames) {
+    EXPECT_LT(started, 2u * kFrames) << "frames " << both.size();
+  }
 }
 
 TEST_F(AdmissionTest, DifferentParametersDoNotShare) {
