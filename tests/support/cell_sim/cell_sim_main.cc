@@ -201,12 +201,14 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   bool stop_injected = false;
   while (!g_stop) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    // Armed, watch closely: at time scale 20 a 100 ms poll is two simulated
+    // seconds, and the arm could reach the box and grip it in between.
+    std::this_thread::sleep_for(std::chrono::milliseconds(stop_armed && !stop_injected ? 2 : 100));
     if (stop_armed && !stop_injected && (*emulator)->controller().Snapshot().program_running) {
-      // A simulated second into the next program: the arm is on its way to the
-      // approach point, nothing on the cup.
+      // Half a simulated second into the next program: the arm is on its way
+      // to the approach point, nothing on the cup.
       std::this_thread::sleep_for(
-          std::chrono::milliseconds(static_cast<int>(1000.0 / options.time_scale)));
+          std::chrono::milliseconds(static_cast<int>(500.0 / options.time_scale)));
       (*emulator)->TriggerProtectiveStop();
       stop_injected = true;
       std::printf("sim: protective stop injected (after %d placed)\n", stop_after);
