@@ -379,113 +379,125 @@ absl::Status RefinementOptions::Validate() const {
   return absl::OkStatus();
 }
 
-RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face,
-                                   const RefinementOptions& options,
-                                   Eigen::Isometry3d* camera_T_box) {
-  RefinementResult result;
-  const Eigen::Isometry3d initial = *camera_T_box;
-  Eigen::Isometry3d pose = initial;
-  for (int it = 0; it < std::max(1, options.iterations); ++it) {
-    FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
-    std::vector<FacePoint> front, grid;
-    const std::vector<FacePoint> pts =
-        CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m, &front, &grid);
-    const double pixel_m = f.c.z() / depth.camera.fx;  // point spacing on the face
-    // Plane through the interior points.
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    int n = 0;
-    for (const FacePoint& p : pts) {
-      if (std::abs(p.a) > f.half_a - 0.01 || std::abs(p.b) > f.half_b - 0.01) continue;
-      mean += Eigen::Vector3d(p.a, p.b, p.n);
-      ++n;
-    }
-    if (n < 30) return result;
-    mean /= n;
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (const FacePoint& p : pts) {
-      if (std::abs(p.a) > f.half_a - 0.01 || std::abs(p.b) > f.half_b - 0.01) continue;
-      const Eigen::Vector3d d = Eigen::Vector3d(p.a, p.b, p.n) - mean;
-      cov += d * d.transpose();
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    Eigen::Vector3d normal_local = eig.eigenvectors().col(0);
-    if (normal_local.z() < 0.0) normal_local = -normal_local;
-    result.plane_rms_m = std::sqrt(std::max(0.0, eig.eigenvalues()(0)) / n);
-    result.face_points = n;
+namespace {
 
-    // Sides: +a, -a, +b, -b.
-    SideMeasure pa = MeasureSide(pts, front, grid, true, 1.0, f.half_a, f.half_b, pixel_m, options);
-    SideMeasure ma =
-        MeasureSide(pts, front, grid, true, -1.0, f.half_a, f.half_b, pixel_m, options);
-    SideMeasure pb =
-        MeasureSide(pts, front, grid, false, 1.0, f.half_b, f.half_a, pixel_m, options);
-    SideMeasure mb =
-        MeasureSide(pts, front, grid, false, -1.0, f.half_b, f.half_a, pixel_m, options);
-    // Where the depth shows the face running on with no seam, a straight
-    // line in the colour image along the whole side is one.
-    if (depth.has_grey()) {
-      ColourSeamSide(depth, f, true, 1.0, options, &pa);
-      ColourSeamSide(depth, f, true, -1.0, options, &ma);
-      ColourSeamSide(depth, f, false, 1.0, options, &pb);
-      ColourSeamSide(depth, f, false, -1.0, options, &mb);
-    }
-    result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
-    result.free_sides = 0;
-    for (SideKind k : result.sides) result.free_sides += k == SideKind::kFree;
-    auto offset = [](const SideMeasure& plus, const SideMeasure& minus, double half) {
-      if (plus.measured() && minus.measured()) return 0.5 * (plus.position - minus.position);
-      if (plus.measured()) return plus.position - half;
-      if (minus.measured()) return half - minus.position;
-      return 0.0;
-    };
-    const double da = offset(pa, ma, f.half_a);
-    const double db = offset(pb, mb, f.half_b);
-    result.extent_a_m = pa.measured() && ma.measured() ? pa.position + ma.position : 0.0;
-    result.extent_b_m = pb.measured() && mb.measured() ? pb.position + mb.position : 0.0;
-    // Turn about the normal: a side along b (the +-a sides) turning by
-    // slope s means the a axis turns by -s toward b... average all sides.
-    std::vector<double> turns;
-    if (pa.kind == SideKind::kFree) turns.push_back(-pa.slope);
-    if (ma.kind == SideKind::kFree) turns.push_back(ma.slope);
-    if (pb.kind == SideKind::kFree) turns.push_back(pb.slope);
-    if (mb.kind == SideKind::kFree) turns.push_back(-mb.slope);
-    double turn = 0.0;
-    if (!turns.empty()) turn = std::atan(Median(turns));
-
-    // New face frame.
-    const Eigen::Vector3d n_cam =
-        (normal_local.x() * f.a + normal_local.y() * f.b + normal_local.z() * f.n).normalized();
-    Eigen::Vector3d a_cam = (std::cos(turn) * f.a + std::sin(turn) * f.b);
-    a_cam = (a_cam - a_cam.dot(n_cam) * n_cam).normalized();
-    const Eigen::Vector3d b_cam = f.sign_n * n_cam.cross(a_cam);  // keeps R right-handed
-    const Eigen::Vector3d mean_cam = f.c + mean.x() * f.a + mean.y() * f.b + mean.z() * f.n;
-    Eigen::Vector3d centre = f.c + da * f.a + db * f.b;
-    centre += (mean_cam - centre).dot(n_cam) * n_cam;  // onto the fitted plane
-
-    Eigen::Matrix3d R;
-    R.col(f.axis_n) = f.sign_n * n_cam;
-    R.col(f.axis_a) = a_cam;
-    R.col(f.axis_b) = b_cam;
-    pose.linear() = R;
-    pose.translation() = centre - n_cam * dims[f.axis_n] / 2.0;
+// One refinement step: the face's plane from its interior points, each
+// side measured (free, seam, continuing, occluded), and the pose moved onto
+// the plane and the measured sides. False when the face has too few points.
+bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face,
+                const RefinementOptions& options, Eigen::Isometry3d& pose,
+                RefinementResult& result) {
+  FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
+  std::vector<FacePoint> front, grid;
+  const std::vector<FacePoint> pts =
+      CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m, &front, &grid);
+  const double pixel_m = f.c.z() / depth.camera.fx;  // point spacing on the face
+  // Plane through the interior points.
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (const FacePoint& p : pts) {
+    if (std::abs(p.a) > f.half_a - 0.01 || std::abs(p.b) > f.half_b - 0.01) continue;
+    mean += Eigen::Vector3d(p.a, p.b, p.n);
+    ++n;
   }
-  // A free side whose edge is the border of a shadow cast by something
-  // standing over the face is no edge of the face.
-  {
-    const FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
-    const Eigen::Vector3d across[4] = {f.a, -f.a, f.b, -f.b};
-    const Eigen::Vector3d along[4] = {f.b, f.b, f.a, f.a};
-    const double half_across[4] = {f.half_a, f.half_a, f.half_b, f.half_b};
-    const double half_along[4] = {f.half_b, f.half_b, f.half_a, f.half_a};
-    for (int i = 0; i < 4; ++i) {
-      if (result.sides[i] == SideKind::kFree &&
-          ShadowedByOccluder(depth, f.c + half_across[i] * across[i], across[i], along[i],
-                             half_along[i], f.n, options)) {
-        result.sides[i] = SideKind::kOccluded;
-        --result.free_sides;
-      }
+  if (n < 30) return false;
+  mean /= n;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const FacePoint& p : pts) {
+    if (std::abs(p.a) > f.half_a - 0.01 || std::abs(p.b) > f.half_b - 0.01) continue;
+    const Eigen::Vector3d d = Eigen::Vector3d(p.a, p.b, p.n) - mean;
+    cov += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  Eigen::Vector3d normal_local = eig.eigenvectors().col(0);
+  if (normal_local.z() < 0.0) normal_local = -normal_local;
+  result.plane_rms_m = std::sqrt(std::max(0.0, eig.eigenvalues()(0)) / n);
+  result.face_points = n;
+
+  // Sides: +a, -a, +b, -b.
+  SideMeasure pa = MeasureSide(pts, front, grid, true, 1.0, f.half_a, f.half_b, pixel_m, options);
+  SideMeasure ma =
+      MeasureSide(pts, front, grid, true, -1.0, f.half_a, f.half_b, pixel_m, options);
+  SideMeasure pb =
+      MeasureSide(pts, front, grid, false, 1.0, f.half_b, f.half_a, pixel_m, options);
+  SideMeasure mb =
+      MeasureSide(pts, front, grid, false, -1.0, f.half_b, f.half_a, pixel_m, options);
+  // Where the depth shows the face running on with no seam, a straight
+  // line in the colour image along the whole side is one.
+  if (depth.has_grey()) {
+    ColourSeamSide(depth, f, true, 1.0, options, &pa);
+    ColourSeamSide(depth, f, true, -1.0, options, &ma);
+    ColourSeamSide(depth, f, false, 1.0, options, &pb);
+    ColourSeamSide(depth, f, false, -1.0, options, &mb);
+  }
+  result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
+  result.free_sides = 0;
+  for (SideKind k : result.sides) result.free_sides += k == SideKind::kFree;
+  auto offset = [](const SideMeasure& plus, const SideMeasure& minus, double half) {
+    if (plus.measured() && minus.measured()) return 0.5 * (plus.position - minus.position);
+    if (plus.measured()) return plus.position - half;
+    if (minus.measured()) return half - minus.position;
+    return 0.0;
+  };
+  const double da = offset(pa, ma, f.half_a);
+  const double db = offset(pb, mb, f.half_b);
+  result.extent_a_m = pa.measured() && ma.measured() ? pa.position + ma.position : 0.0;
+  result.extent_b_m = pb.measured() && mb.measured() ? pb.position + mb.position : 0.0;
+  // Turn about the normal: a side along b (the +-a sides) turning by
+  // slope s means the a axis turns by -s toward b... average all sides.
+  std::vector<double> turns;
+  if (pa.kind == SideKind::kFree) turns.push_back(-pa.slope);
+  if (ma.kind == SideKind::kFree) turns.push_back(ma.slope);
+  if (pb.kind == SideKind::kFree) turns.push_back(pb.slope);
+  if (mb.kind == SideKind::kFree) turns.push_back(-mb.slope);
+  double turn = 0.0;
+  if (!turns.empty()) turn = std::atan(Median(turns));
+
+  // New face frame.
+  const Eigen::Vector3d n_cam =
+      (normal_local.x() * f.a + normal_local.y() * f.b + normal_local.z() * f.n).normalized();
+  Eigen::Vector3d a_cam = (std::cos(turn) * f.a + std::sin(turn) * f.b);
+  a_cam = (a_cam - a_cam.dot(n_cam) * n_cam).normalized();
+  const Eigen::Vector3d b_cam = f.sign_n * n_cam.cross(a_cam);  // keeps R right-handed
+  const Eigen::Vector3d mean_cam = f.c + mean.x() * f.a + mean.y() * f.b + mean.z() * f.n;
+  Eigen::Vector3d centre = f.c + da * f.a + db * f.b;
+  centre += (mean_cam - centre).dot(n_cam) * n_cam;  // onto the fitted plane
+
+  Eigen::Matrix3d R;
+  R.col(f.axis_n) = f.sign_n * n_cam;
+  R.col(f.axis_a) = a_cam;
+  R.col(f.axis_b) = b_cam;
+  pose.linear() = R;
+  pose.translation() = centre - n_cam * dims[f.axis_n] / 2.0;
+  return true;
+}
+
+// Free sides whose edge is the border of a shadow cast by something
+// standing over the face are no edges of it: they become kOccluded.
+void MarkShadowedSides(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face,
+                       const RefinementOptions& options, const Eigen::Isometry3d& pose,
+                       RefinementResult& result) {
+  const FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
+  const Eigen::Vector3d across[4] = {f.a, -f.a, f.b, -f.b};
+  const Eigen::Vector3d along[4] = {f.b, f.b, f.a, f.a};
+  const double half_across[4] = {f.half_a, f.half_a, f.half_b, f.half_b};
+  const double half_along[4] = {f.half_b, f.half_b, f.half_a, f.half_a};
+  for (int i = 0; i < 4; ++i) {
+    if (result.sides[i] == SideKind::kFree &&
+        ShadowedByOccluder(depth, f.c + half_across[i] * across[i], across[i], along[i],
+                           half_along[i], f.n, options)) {
+      result.sides[i] = SideKind::kOccluded;
+      --result.free_sides;
     }
   }
+}
+
+// Continuing sides become kTiled where the layer they run on tiles with
+// whole boxes, and with fewer than any other reading of the face (see
+// the comment inside).
+void TileContinuingSides(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face,
+                         const RefinementOptions& options, const Eigen::Isometry3d& pose,
+                         RefinementResult& result) {
   // Sides where the face runs on without a visible seam (pallet layers with
   // fine gaps): the face may be one tile of a layer of touching boxes, or a
   // part of a bigger face. The coplanar run through the box is measured to
@@ -561,6 +573,21 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
       }
     }
   }
+}
+
+}  // namespace
+
+RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face,
+                                   const RefinementOptions& options,
+                                   Eigen::Isometry3d* camera_T_box) {
+  RefinementResult result;
+  const Eigen::Isometry3d initial = *camera_T_box;
+  Eigen::Isometry3d pose = initial;
+  for (int it = 0; it < std::max(1, options.iterations); ++it) {
+    if (!RefineStep(depth, dims, grasp_face, options, pose, result)) return result;
+  }
+  MarkShadowedSides(depth, dims, grasp_face, options, pose, result);
+  TileContinuingSides(depth, dims, grasp_face, options, pose, result);
   const double shift = (pose.translation() - initial.translation()).norm();
   const double turn_deg = Eigen::AngleAxisd(initial.linear().transpose() * pose.linear()).angle() *
                           180.0 / std::numbers::pi;
