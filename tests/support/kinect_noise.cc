@@ -5,13 +5,13 @@
 #include <limits>
 #include <numbers>
 
+#include "tests/support/pixel_status.h"
+
 namespace cornerpose::testing::internal {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-enum Status : uint8_t { kValid, kNoReturn, kShadow, kGrazing, kDropout };
 
 // Angle between a surface normal and the direction towards a viewpoint.
 double Incidence(const Eigen::Vector3d& normal, const Eigen::Vector3d& to_viewer) {
@@ -216,29 +216,7 @@ std::vector<double> ApplyKinectNoise(const RayCaster& caster, const CameraIntrin
       }
     }
   }
-  for (int i = 0; i < n; ++i) {
-    if (status[i] == kValid && !(depth[i] >= noise.min_range_m && depth[i] <= noise.max_range_m)) {
-      status[i] = kNoReturn;
-    }
-    switch (status[i]) {
-      case kValid:
-        ++stats->valid;
-        break;
-      case kNoReturn:
-        ++stats->no_return;
-        break;
-      case kShadow:
-        ++stats->shadow;
-        break;
-      case kGrazing:
-        ++stats->grazing;
-        break;
-      case kDropout:
-        ++stats->dropout;
-        break;
-    }
-    if (status[i] != kValid) depth[i] = kNaN;
-  }
+  FinishPixels(status, noise.min_range_m, noise.max_range_m, /*output_step_m=*/0.0, depth, stats);
   return depth;
 }
 

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "tests/support/kinect_noise.h"
+#include "tests/support/pixel_status.h"
 
 namespace cornerpose::testing::internal {
 namespace {
@@ -14,7 +15,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-enum Status : uint8_t { kValid, kNoReturn, kOccluded, kGrazing, kDropout };
+// The second camera's (or the projector's) shadow.
+constexpr PixelStatus kOccluded = kShadow;
 
 void Filter1d(std::vector<double>* values, int width, int height, int r, bool along_x, bool take_min) {
   if (r <= 0) return;
@@ -200,39 +202,17 @@ std::vector<double> ApplyStereoNoise(const RayCaster& caster, const SurfaceTextu
     }
   }
 
-  // 7. Working range and output units.
+  // 7. Working range and output units; gaps filled from their sides (valid,
+  // in range, moved off the nominal depth by a jump) are counted first.
   for (int i = 0; i < n; ++i) {
-    if (status[i] == kValid &&
-        !(depth[i] >= options.min_range_m && depth[i] <= options.max_range_m)) {
-      status[i] = kNoReturn;
-    }
-    switch (status[i]) {
-      case kValid:
-        ++stats->valid;
-        if (moved[i] && std::isfinite(nominal[i].depth) &&
-            std::abs(depth[i] - nominal[i].depth) > options.jump_m) {
-          ++stats->filled;
-        }
-        break;
-      case kNoReturn:
-        ++stats->no_return;
-        break;
-      case kOccluded:
-        ++stats->shadow;
-        break;
-      case kGrazing:
-        ++stats->grazing;
-        break;
-      case kDropout:
-        ++stats->dropout;
-        break;
-    }
-    if (status[i] != kValid) {
-      depth[i] = kNaN;
-    } else if (options.output_step_m > 0.0) {
-      depth[i] = std::round(depth[i] / options.output_step_m) * options.output_step_m;
+    if (status[i] == kValid && depth[i] >= options.min_range_m && depth[i] <= options.max_range_m &&
+        moved[i] && std::isfinite(nominal[i].depth) &&
+        std::abs(depth[i] - nominal[i].depth) > options.jump_m) {
+      ++stats->filled;
     }
   }
+  FinishPixels(status, options.min_range_m, options.max_range_m, options.output_step_m, depth,
+               stats);
   return depth;
 }
 

@@ -8,6 +8,7 @@
 
 #include "tests/support/color_render.h"
 #include "tests/support/kinect_noise.h"
+#include "tests/support/pixel_status.h"
 
 namespace cornerpose::testing::internal {
 namespace {
@@ -16,7 +17,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Half the wavelength of an 80 MHz modulation: the unambiguous range, m.
 constexpr double kHalfWavelength = 299792458.0 / (2.0 * 80e6);
 
-enum Status : uint8_t { kValid, kNoReturn, kWeak, kDropout };
+// Too weak a return.
+constexpr PixelStatus kWeak = kGrazing;
 
 // Near-infrared reflectance from the visible albedo: cardboard, wood and
 // concrete are brighter in the NIR than they look; black print stays dark.
@@ -170,39 +172,9 @@ std::vector<double> ApplyTofNoise(const RayCaster& caster, const SurfaceTexture&
   // 4. Random dropouts, the working range and output units.
   for (int i = 0; i < n; ++i) {
     if (status[i] == kValid && uniform(rng) < options.dropout_prob) status[i] = kDropout;
-    if (status[i] == kValid &&
-        !(depth[i] >= options.min_range_m && depth[i] <= options.max_range_m)) {
-      status[i] = kNoReturn;
-    }
-    switch (status[i]) {
-      case kValid:
-        ++stats->valid;
-        break;
-      case kNoReturn:
-        ++stats->no_return;
-        break;
-      case kWeak:
-        ++stats->grazing;
-        break;
-      case kDropout:
-        ++stats->dropout;
-        break;
-    }
-    if (status[i] != kValid) {
-      depth[i] = kNaN;
-    } else if (options.output_step_m > 0.0) {
-      depth[i] = std::round(depth[i] / options.output_step_m) * options.output_step_m;
-    }
   }
-
-  if (infrared != nullptr) {
-    infrared->assign(n, 0);
-    for (int i = 0; i < n; ++i) {
-      const double level = std::clamp(1.2 * amplitude[i] + 0.004 * normal(rng), 0.0, 1.0);
-      const uint32_t g = PackColor(Eigen::Vector3d::Constant(level)) & 0xFF;
-      (*infrared)[i] = (g << 16) | (g << 8) | g;
-    }
-  }
+  FinishPixels(status, options.min_range_m, options.max_range_m, options.output_step_m, depth,
+               stats);
   return depth;
 }
 
