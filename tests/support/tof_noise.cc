@@ -175,6 +175,15 @@ std::vector<double> ApplyTofNoise(const RayCaster& caster, const SurfaceTexture&
   }
   FinishPixels(status, options.min_range_m, options.max_range_m, options.output_step_m, depth,
                stats);
+
+  if (infrared != nullptr) {
+    infrared->assign(n, 0);
+    for (int i = 0; i < n; ++i) {
+      const double level = std::clamp(1.2 * amplitude[i] + 0.004 * normal(rng), 0.0, 1.0);
+      const uint32_t g = PackColor(Eigen::Vector3d::Constant(level)) & 0xFF;
+      (*infrared)[i] = (g << 16) | (g << 8) | g;
+    }
+  }
   return depth;
 }
 
