@@ -110,55 +110,55 @@ struct SideMeasure {
 // seam_search_m of the hypothesised side: the Kinect's depth noise is
 // spatially correlated, and a dip searched for everywhere is often noise.
 // Returns the seam's position (outward coordinate) or nothing.
-std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
-                               const std::vector<FacePoint>& grid, bool along_a, double sign,
-                               double half, double half_other, double pixel_m,
-                               const RefinementOptions& o) {
-  const double reach = o.side_band_m;
-  auto band = [&](const FacePoint& p, double* across) {
-    *across = sign * (along_a ? p.a : p.b) - half;
-    const double along = along_a ? p.b : p.a;
-    return std::abs(along) <= half_other - reach && std::abs(*across) < reach;
-  };
-  std::vector<std::pair<double, double>> rows;  // (across - half, height)
-  for (const FacePoint& p : pts) {
-    double across;
-    if (band(p, &across)) rows.emplace_back(across, p.n);
+// The seam test over the points of one stretch of a side (along in
+// [along_lo, along_hi)): strength(c) > 0 where a seam shows at offset c.
+class SeamScan {
+ public:
+  SeamScan(const std::vector<FacePoint>& pts, const std::vector<FacePoint>& grid, bool along_a,
+           double sign, double half, double half_other, double pixel_m, double along_lo,
+           double along_hi, const RefinementOptions& o)
+      : o_(o) {
+    const double reach = o.side_band_m;
+    auto band = [&](const FacePoint& p, double* across) {
+      *across = sign * (along_a ? p.a : p.b) - half;
+      const double along = along_a ? p.b : p.a;
+      return std::abs(along) <= half_other - reach && along >= along_lo && along < along_hi &&
+             std::abs(*across) < reach;
+    };
+    std::vector<std::pair<double, double>> rows;  // (across - half, height)
+    for (const FacePoint& p : pts) {
+      double across;
+      if (band(p, &across)) rows.emplace_back(across, p.n);
+    }
+    for (const FacePoint& p : grid) {  // where pixels meet the plane, same band
+      double across;
+      if (band(p, &across)) expected_.push_back(across);
+    }
+    std::sort(expected_.begin(), expected_.end());
+    std::sort(rows.begin(), rows.end());
+    xs_.resize(rows.size());
+    prefix_.assign(rows.size() + 1, 0.0);
+    for (size_t i = 0; i < rows.size(); ++i) {
+      xs_[i] = rows[i].first;
+      prefix_[i + 1] = prefix_[i] + rows[i].second;
+    }
+    w_ = std::max(0.003, 2.5 * pixel_m);  // centre window width
+    f0_ = w_ / 2 + pixel_m;               // flanks
+    f1_ = w_ / 2 + 6 * pixel_m;
   }
-  std::vector<double> expected;  // where pixels meet the plane, same band
-  for (const FacePoint& p : grid) {
-    double across;
-    if (band(p, &across)) expected.push_back(across);
-  }
-  if (rows.size() < 50 || expected.size() < 50) return std::nullopt;
-  std::sort(expected.begin(), expected.end());
-  auto expected_in = [&](double lo, double hi) {
-    return static_cast<double>(std::lower_bound(expected.begin(), expected.end(), hi) -
-                               std::lower_bound(expected.begin(), expected.end(), lo));
-  };
-  std::sort(rows.begin(), rows.end());
-  std::vector<double> xs(rows.size()), prefix(rows.size() + 1, 0.0);
-  for (size_t i = 0; i < rows.size(); ++i) {
-    xs[i] = rows[i].first;
-    prefix[i + 1] = prefix[i] + rows[i].second;
-  }
-  // Count and height sum of points with across in [lo, hi).
-  auto window = [&](double lo, double hi) {
-    const size_t a = std::lower_bound(xs.begin(), xs.end(), lo) - xs.begin();
-    const size_t b = std::lower_bound(xs.begin(), xs.end(), hi) - xs.begin();
-    return std::pair<double, double>(static_cast<double>(b - a), prefix[b] - prefix[a]);
-  };
-  const double w = std::max(0.003, 2.5 * pixel_m);              // centre window width
-  const double f0 = w / 2 + pixel_m, f1 = w / 2 + 6 * pixel_m;  // flanks
-  std::optional<double> best;
-  double best_strength = 0.0;
-  for (double c = -o.seam_search_m; c <= o.seam_search_m + 1e-9; c += 0.001) {
-    const auto [nc, sc] = window(c - w / 2, c + w / 2);
-    const auto [nl, sl] = window(c - f1, c - f0);
-    const auto [nr, sr] = window(c + f0, c + f1);
-    const double ec = expected_in(c - w / 2, c + w / 2);
-    const double ef = expected_in(c - f1, c - f0) + expected_in(c + f0, c + f1);
-    if (nl < 10 || nr < 10 || ec < 5 || ef < 10) continue;
+
+  size_t points() const { return xs_.size(); }
+  size_t expected() const { return expected_.size(); }
+
+  // How far past its threshold the strongest test is at offset c (<= 0: no
+  // seam there); nullopt when too few points to say.
+  std::optional<double> Strength(double c) const {
+    const auto [nc, sc] = Window(c - w_ / 2, c + w_ / 2);
+    const auto [nl, sl] = Window(c - f1_, c - f0_);
+    const auto [nr, sr] = Window(c + f0_, c + f1_);
+    const double ec = ExpectedIn(c - w_ / 2, c + w_ / 2);
+    const double ef = ExpectedIn(c - f1_, c - f0_) + ExpectedIn(c + f0_, c + f1_);
+    if (nl < 10 || nr < 10 || ec < 5 || ef < 10) return std::nullopt;
     // Share of the pixels that should see the plane and do, at the centre
     // against the flanks: the pixel grid's own pattern cancels out.
     const double density_ratio = (nc / ec) / ((nl + nr) / ef);
@@ -166,20 +166,64 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
         nc >= 5 ? (sl + sr) / (nl + nr) - sc / nc : 0.0;  // how much lower the centre is
     // Strength: how far past its threshold each test is; a weaker dip in
     // density counts when a groove half as deep as the threshold backs it.
-    const double density_strength = (o.max_seam_density - density_ratio) / o.max_seam_density;
-    const double groove_strength = (groove - o.min_seam_depth_m) / o.min_seam_depth_m;
+    const double density_strength = (o_.max_seam_density - density_ratio) / o_.max_seam_density;
+    const double groove_strength = (groove - o_.min_seam_depth_m) / o_.min_seam_depth_m;
     const double joint_strength =
-        std::min((o.weak_seam_density - density_ratio) / o.weak_seam_density,
-                 (groove - 0.5 * o.min_seam_depth_m) / o.min_seam_depth_m);
-    const double strength = std::max({density_strength, groove_strength, joint_strength});
-    if (strength > 0.0 && strength > best_strength) {
-      best_strength = strength;
+        std::min((o_.weak_seam_density - density_ratio) / o_.weak_seam_density,
+                 (groove - 0.5 * o_.min_seam_depth_m) / o_.min_seam_depth_m);
+    return std::max({density_strength, groove_strength, joint_strength});
+  }
+
+ private:
+  // Count and height sum of points with across in [lo, hi).
+  std::pair<double, double> Window(double lo, double hi) const {
+    const size_t a = std::lower_bound(xs_.begin(), xs_.end(), lo) - xs_.begin();
+    const size_t b = std::lower_bound(xs_.begin(), xs_.end(), hi) - xs_.begin();
+    return {static_cast<double>(b - a), prefix_[b] - prefix_[a]};
+  }
+  double ExpectedIn(double lo, double hi) const {
+    return static_cast<double>(std::lower_bound(expected_.begin(), expected_.end(), hi) -
+                               std::lower_bound(expected_.begin(), expected_.end(), lo));
+  }
+
+  const RefinementOptions& o_;
+  std::vector<double> xs_, prefix_, expected_;
+  double w_ = 0.0, f0_ = 0.0, f1_ = 0.0;
+};
+
+std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
+                               const std::vector<FacePoint>& grid, bool along_a, double sign,
+                               double half, double half_other, double pixel_m,
+                               const RefinementOptions& o) {
+  constexpr double kAll = std::numeric_limits<double>::infinity();
+  const SeamScan whole(pts, grid, along_a, sign, half, half_other, pixel_m, -kAll, kAll, o);
+  if (whole.points() < 50 || whole.expected() < 50) return std::nullopt;
+  std::optional<double> best;
+  double best_strength = 0.0;
+  for (double c = -o.seam_search_m; c <= o.seam_search_m + 1e-9; c += 0.001) {
+    const std::optional<double> strength = whole.Strength(c);
+    if (strength && *strength > 0.0 && *strength > best_strength) {
+      best_strength = *strength;
       best = c;
     }
   }
   // A dip at the end of the search range is the flank of something
   // further away, not a seam here.
   if (!best || std::abs(*best) > o.seam_search_m - 0.0015) return std::nullopt;
+  // A seam runs the whole side: each half of it shows one near the same
+  // offset (within a millimetre), if only a weak one. A cluster of missing
+  // returns in one place (Kinect speckle) makes a dip in the whole side's
+  // sums but not in both halves.
+  if (o.seam_halves_min_strength > -1.0) {
+    for (const auto& [lo, hi] : {std::pair{-kAll, 0.0}, std::pair{0.0, kAll}}) {
+      const SeamScan part(pts, grid, along_a, sign, half, half_other, pixel_m, lo, hi, o);
+      double strongest = -kAll;
+      for (double c = *best - 0.001; c <= *best + 0.001 + 1e-9; c += 0.001) {
+        if (const std::optional<double> st = part.Strength(c)) strongest = std::max(strongest, *st);
+      }
+      if (std::isfinite(strongest) && strongest <= o.seam_halves_min_strength) return std::nullopt;
+    }
+  }
   return half + *best;
 }
 
@@ -367,6 +411,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.max_seam_density", max_seam_density, 0.0, 1.0),
            CheckRange("refinement.weak_seam_density", weak_seam_density, 0.0, 1.0),
            CheckRange("refinement.seam_search_m", seam_search_m, 0.0, 0.2),
+           CheckRange("refinement.seam_halves_min_strength", seam_halves_min_strength, -10.0, 1.0),
            CheckRange("refinement.tile_gap_m", tile_gap_m, 0.0, 0.2),
            CheckRange("refinement.tile_tolerance_m", tile_tolerance_m, 0.0, 0.2),
            CheckRange("refinement.max_tile_march_m", max_tile_march_m, 0.0, 100.0),

@@ -38,6 +38,11 @@ struct RefinementOptions {
   // The groove is looked for this far either side of the hypothesised side.
   // Metres.
   double seam_search_m = 0.006;
+  // A seam must show in each half of the side too, with at least this
+  // strength (how far past its thresholds; 0 = at them, negative = short of
+  // them by that share): random clusters of missing returns make a dip in
+  // one place. -1 or less: no such check.
+  double seam_halves_min_strength = 0.0;
   // A face that runs on past a side is one tile of a layer when the layer
   // ends a whole number of (box size + tile_gap_m) away, within
   // tile_tolerance_m, searched up to max_tile_march_m (0 disables). Metres.
