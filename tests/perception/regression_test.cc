@@ -172,6 +172,51 @@ TEST(RegressionTest, NoSeamInTheMiddleOfANoiseFreeFlatFace) {
   EXPECT_NE(r.sides[3], SideKind::kSeam);
 }
 
+// A seam shows along the whole side: a line of missing returns down the
+// middle of a flat top (noise-free render), on half the side only, is the
+// kind of dip a cluster of Kinect speckle holes makes; it was a seam (a
+// box-wide strip cut out of the face), and is not with the halves rule
+// (RefinementOptions::seam_halves_min_strength). The same line along the
+// whole side is a seam either way.
+TEST(RegressionTest, AHoleLineOnHalfASideIsNoSeam) {
+  NoiseOptions noise;
+  noise.enabled = false;
+  const RenderedScene out = Render(MakeIsolatedScene(kCartonS, 3, 2), noise);
+  const Eigen::Isometry3d camera_T_true = out.boxes.at(0).camera_T_box;
+  // Missing returns on the top's middle line x = 0 (2 mm either side), for
+  // y in [y0, y1) of the true box.
+  auto with_holes = [&](double y0, double y1) {
+    PointCloud cloud = out.cloud;
+    for (Eigen::Vector3f& p : cloud.xyz) {
+      if (!PointCloud::IsValid(p)) continue;
+      const Eigen::Vector3d q = camera_T_true.inverse() * p.cast<double>();
+      if (std::abs(q.z() - 0.075) < 0.005 && std::abs(q.x()) < 0.002 && q.y() >= y0 &&
+          q.y() < y1) {
+        p = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+      }
+    }
+    return MakeDepthImage(cloud, out.camera);
+  };
+  Eigen::Matrix3d R;
+  R.col(0) = Eigen::Vector3d::UnitZ();
+  R.col(2) = -Eigen::Vector3d::UnitX();
+  R.col(1) = R.col(2).cross(R.col(0));
+  Eigen::Isometry3d true_T_hyp = Eigen::Isometry3d::Identity();
+  true_T_hyp.linear() = R;
+  true_T_hyp.translation() = Eigen::Vector3d(-0.075, 0.0, -0.075);
+  auto minus_b = [&](const DepthImage& depth, double halves) {
+    RefinementOptions options;
+    options.seam_halves_min_strength = halves;
+    Eigen::Isometry3d pose = camera_T_true * true_T_hyp;
+    return RefineOnGraspFace(depth, kCartonS, BoxFace::kPlusX, options, &pose).sides[3];
+  };
+  const DepthImage half_line = with_holes(0.0, 1.0);
+  EXPECT_EQ(minus_b(half_line, -1.0), SideKind::kSeam);  // without the rule
+  EXPECT_NE(minus_b(half_line, RefinementOptions{}.seam_halves_min_strength), SideKind::kSeam);
+  const DepthImage whole_line = with_holes(-1.0, 1.0);
+  EXPECT_EQ(minus_b(whole_line, RefinementOptions{}.seam_halves_min_strength), SideKind::kSeam);
+}
+
 // Was: one point with a finite z but a NaN or infinite x or y (or a wild
 // finite one, x = 1e30) makes DetectBoxes return OK with no boxes at all.
 // PointCloud::IsValid (types.h) checks z only; EstimateIntrinsics
