@@ -217,7 +217,7 @@ TEST_F(CellTest, ProtectiveStopHaltsThePickAndAReleaseResumes) {
         return s.state() == v1::CELL_STATE_STOPPED &&
                s.stop_reason().find("PROTECTIVE_STOP") != std::string::npos;
       },
-      absl::Seconds(10), &status))
+      absl::Seconds(30), &status))
       << status.DebugString();
   // While stopped, nothing is sent.
   const size_t programs_at_stop = emulator_->Snapshot().programs_recorded;
@@ -230,7 +230,7 @@ TEST_F(CellTest, ProtectiveStopHaltsThePickAndAReleaseResumes) {
   ur::DashboardClient dashboard;
   ASSERT_TRUE(dashboard.Connect("127.0.0.1", emulator_->dashboard_port()).ok());
   bool released = false;
-  for (int i = 0; i < 100 && !released; ++i) {
+  for (int i = 0; i < 400 && !released; ++i) {  // 20 s: a loaded machine
     released = dashboard.UnlockProtectiveStop().ok();
     if (!released) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
@@ -244,7 +244,7 @@ TEST_F(CellTest, ProtectiveStopHaltsThePickAndAReleaseResumes) {
         return s.state() == v1::CELL_STATE_STOPPED &&
                s.stop_reason().find("suction output is on") != std::string::npos;
       },
-      absl::Seconds(10), &status))
+      absl::Seconds(30), &status))
       << status.DebugString();
   EXPECT_EQ(emulator_->Snapshot().programs_recorded, programs_at_stop);
   emulator_->controller().SubmitScript(
