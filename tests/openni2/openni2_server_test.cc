@@ -90,12 +90,15 @@ TEST_F(OpenNi2ServerTest, DetectOnOpenNi2SourcesFindsBoxesAndFailedOnesAreUnavai
     EXPECT_GT(response.frame_id(), 0u);
     EXPECT_GT(response.boxes_size(), 0) << name;
     EXPECT_EQ(response.source_live(), name == "cam");
-    // The device's own frame time comes through (the driver's: index / fps).
-    v1::DetectResponse later;
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    ASSERT_TRUE(DetectOn(name, &later).ok());
-    if (later.frame_id() > response.frame_id()) {
-      EXPECT_GT(later.device_timestamp_us(), response.device_timestamp_us()) << name;
+    // The device's own frame time comes through (the virtual camera's:
+    // index / fps; the recording keeps what oni_record stored).
+    if (name == "cam") {
+      v1::DetectResponse later;
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+      ASSERT_TRUE(DetectOn(name, &later).ok());
+      if (later.frame_id() > response.frame_id()) {
+        EXPECT_GT(later.device_timestamp_us(), response.device_timestamp_us()) << name;
+      }
     }
   }
   WaitForSource("gone");

@@ -3,6 +3,7 @@
 // stream, errors, the embedded page, /api/cell and /metrics moving as
 // requests are made.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -27,9 +28,11 @@ using nlohmann::json;
 const fs::path kCartonFrames = fs::path(CORNERPOSE_SOURCE_DIR) / "data/frames/carton_s";
 
 // A directory holding one recorded frame, so every frame of a source on it
-// is the same file.
+// is the same file; one per process (ctest runs this binary's tests side by
+// side, and one rewriting the frame while another reads it broke the PNG).
 fs::path OneFrameDirectory() {
-  const fs::path dir = fs::path(::testing::TempDir()) / "http_one_frame";
+  const fs::path dir =
+      fs::path(::testing::TempDir()) / ("http_one_frame_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   for (const char* name : {"heap_001.png", "intrinsics.txt"}) {
     fs::copy_file(kCartonFrames / name, dir / name, fs::copy_options::overwrite_existing);
