@@ -4,7 +4,9 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <string>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -64,6 +66,27 @@ void ApplySizeTolerance(double t, DetectorOptions* o) {
   o->acceptance.extent_tolerance_m = t + 0.01;
 }
 
+// Takes out the boxes (and their side kinds) for which `why(i)` gives a
+// reason, declining each with it. True when one was taken out.
+bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<std::array<SideKind, 4>>* sides,
+             std::vector<DeclinedCandidate>* declined,
+             const std::function<std::string(size_t)>& why) {
+  size_t kept = 0;
+  for (size_t i = 0; i < boxes->size(); ++i) {
+    if (std::string reason = why(i); !reason.empty()) {
+      declined->push_back({(*boxes)[i].camera_T_box, (*boxes)[i].score, std::move(reason)});
+      continue;
+    }
+    (*boxes)[kept] = (*boxes)[i];
+    (*sides)[kept] = (*sides)[i];
+    ++kept;
+  }
+  const bool removed = kept < boxes->size();
+  boxes->resize(kept);
+  sides->resize(kept);
+  return removed;
+}
+
 // A box cannot reach through the floor. The floor is the farthest large
 // plane the camera sees (a planar patch of at least floor_min_area_m2, and
 // three of the box's largest faces, whose plane lies farthest from the
@@ -105,9 +128,7 @@ bool CheckFloor(const DepthImage& depth, const DetectorOptions& options,
     }
   }
   if (seen == 0 || beyond > 0.01 * seen) return false;
-  bool removed = false;
-  size_t kept = 0;
-  for (size_t i = 0; i < boxes->size(); ++i) {
+  return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
     const Eigen::Isometry3d& pose = (*boxes)[i].camera_T_box;
     double deepest = -std::numeric_limits<double>::max();
     for (int c = 0; c < 8; ++c) {
@@ -117,21 +138,11 @@ bool CheckFloor(const DepthImage& depth, const DetectorOptions& options,
       // How far beyond the floor, away from the camera.
       deepest = std::max(deepest, -floor->normal.dot(corner - floor->centroid));
     }
-    if (deepest > options.floor_tolerance_m) {
-      declined->push_back({pose, (*boxes)[i].score,
-                           absl::StrFormat("the box would reach %.0f mm into the floor (a "
-                                           "flat piece of something else of a face's size)",
-                                           1000.0 * deepest)});
-      removed = true;
-      continue;
-    }
-    (*boxes)[kept] = (*boxes)[i];
-    (*sides)[kept] = (*sides)[i];
-    ++kept;
-  }
-  boxes->resize(kept);
-  sides->resize(kept);
-  return removed;
+    if (deepest <= options.floor_tolerance_m) return "";
+    return absl::StrFormat("the box would reach %.0f mm into the floor (a flat piece of "
+                           "something else of a face's size)",
+                           1000.0 * deepest);
+  });
 }
 
 // The layer check (FaceProposalOptions::check_layer_tiling). A layer is
@@ -161,30 +172,18 @@ bool CheckLayers(const DepthImage& depth, const DetectorOptions& options,
     const bool free_b = s[2] == SideKind::kFree || s[3] == SideKind::kFree;
     if (tile[i] && free_a && free_b) trusted[layer[i]] = true;
   }
-  bool removed = false;
-  size_t kept = 0;
-  for (size_t i = 0; i < n; ++i) {
+  return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
     const std::array<SideKind, 4>& s = (*sides)[i];
     const bool bounded_by_seams = std::any_of(s.begin(), s.end(), [](SideKind k) {
       return k == SideKind::kSeam || k == SideKind::kTiled || k == SideKind::kContinues;
     });
-    if (layer[i] >= 0 && trusted[layer[i]] && !tile[i] && bounded_by_seams) {
-      declined->push_back(
-          {(*boxes)[i].camera_T_box, (*boxes)[i].score,
-           absl::StrFormat("its face lies on a layer that tiles with %d box faces (a box ended by "
-                           "depth jumps is one of them) and it is none of them: a strip of a face "
-                           "cut by a false seam, or a box turned across the layer",
-                           static_cast<int>(faces.layers[layer[i]].tiles.size()))});
-      removed = true;
-      continue;
-    }
-    (*boxes)[kept] = (*boxes)[i];
-    (*sides)[kept] = (*sides)[i];
-    ++kept;
-  }
-  boxes->resize(kept);
-  sides->resize(kept);
-  return removed;
+    if (layer[i] < 0 || !trusted[layer[i]] || tile[i] || !bounded_by_seams) return "";
+    return absl::StrFormat(
+        "its face lies on a layer that tiles with %d box faces (a box ended by depth jumps is "
+        "one of them) and it is none of them: a strip of a face cut by a false seam, or a box "
+        "turned across the layer",
+        static_cast<int>(faces.layers[layer[i]].tiles.size()));
+  });
 }
 
 // The strongest declined hypotheses: none that overlaps a returned box (a
