@@ -159,12 +159,28 @@ void PrintDetection(const std::string& label, std::optional<size_t> num_points,
 
 int RunDetect(const std::vector<std::string>& argv) {
   if (PrintHelpIfAsked(argv, kHelp)) return 0;
-  absl::StatusOr<CommandArgs> args = ParseCommandArgs(
-      argv,
-      {"cloud", "box", "intrinsics", "json", "ply", "png", "edges", "radius", "threshold",
-       "samples", "ransac_threshold", "meet_distance", "threads", "coarse_step", "denoise",
-       "color", "faces", "layer_check", "floor_check", "size_tolerance"},
-      {"quiet", "kdtree"});
+  absl::StatusOr<CommandArgs> args = ParseCommandArgs(argv,
+                                                      {"cloud",
+                                                       "box",
+                                                       "intrinsics",
+                                                       "json",
+                                                       "ply",
+                                                       "png",
+                                                       "edges",
+                                                       "radius",
+                                                       "threshold",
+                                                       "samples",
+                                                       "ransac_threshold",
+                                                       "meet_distance",
+                                                       "threads",
+                                                       "coarse_step",
+                                                       "denoise",
+                                                       "color",
+                                                       "faces",
+                                                       "layer_check",
+                                                       "floor_check",
+                                                       "size_tolerance"},
+                                                      {"quiet", "kdtree"});
   if (!args.ok()) {
     std::fprintf(stderr, "cornerpose detect: %s\n\n%s",
                  std::string(args.status().message()).c_str(), kHelp);

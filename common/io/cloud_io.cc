@@ -200,8 +200,7 @@ absl::StatusOr<PointCloud> LoadDepthImage(const std::string& path, const LoadOpt
   // NAME.png (the recorded-frame convention), used when it is there.
   if (!options.color_path && options.color_from_beside) {
     const std::filesystem::path p(path);
-    const std::filesystem::path beside =
-        p.parent_path() / (p.stem().string() + ".color.png");
+    const std::filesystem::path beside = p.parent_path() / (p.stem().string() + ".color.png");
     std::error_code ec;
     if (std::filesystem::is_regular_file(beside, ec)) {
       if (absl::Status s = AttachColor(beside.string(), &cloud); !s.ok()) return s;

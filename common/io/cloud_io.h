@@ -51,8 +51,8 @@ absl::Status AttachColor(const std::string& path, PointCloud* cloud);
 
 // Back-projects a depth image (row-major, camera.width x camera.height) into
 // an organized cloud: x = (u - cx) z / fx, y = (v - cy) z / fy, z = d *
-// depth_scale_m; d = 0 and d = 65535 (no return on some stereo cameras) give NaN. Returns an empty cloud when depth.size()
-// does not match the intrinsics.
+// depth_scale_m; d = 0 and d = 65535 (no return on some stereo cameras) give NaN. Returns an empty
+// cloud when depth.size() does not match the intrinsics.
 PointCloud DepthToCloud(const std::vector<uint16_t>& depth, const CameraIntrinsics& camera,
                         double depth_scale_m);
 

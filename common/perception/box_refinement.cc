@@ -461,12 +461,9 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
 
   // Sides: +a, -a, +b, -b.
   SideMeasure pa = MeasureSide(pts, front, grid, true, 1.0, f.half_a, f.half_b, pixel_m, options);
-  SideMeasure ma =
-      MeasureSide(pts, front, grid, true, -1.0, f.half_a, f.half_b, pixel_m, options);
-  SideMeasure pb =
-      MeasureSide(pts, front, grid, false, 1.0, f.half_b, f.half_a, pixel_m, options);
-  SideMeasure mb =
-      MeasureSide(pts, front, grid, false, -1.0, f.half_b, f.half_a, pixel_m, options);
+  SideMeasure ma = MeasureSide(pts, front, grid, true, -1.0, f.half_a, f.half_b, pixel_m, options);
+  SideMeasure pb = MeasureSide(pts, front, grid, false, 1.0, f.half_b, f.half_a, pixel_m, options);
+  SideMeasure mb = MeasureSide(pts, front, grid, false, -1.0, f.half_b, f.half_a, pixel_m, options);
   // Where the depth shows the face running on with no seam, a straight
   // line in the colour image along the whole side is one.
   if (depth.has_grey()) {

@@ -31,7 +31,7 @@ double MsSince(Clock::time_point t0) {
 // so do depths nearer than any depth camera measures (the pixel radius
 // r fx / z grows without bound as z -> 0). Copies only when needed.
 const PointCloud& SanitizeCloud(const PointCloud& cloud, PointCloud* storage) {
-  constexpr float kMaxCoordinate = 100.0f;  // metres
+  constexpr float kMaxCoordinate = 100.0f;   // metres
   constexpr float kMinCameraDepthM = 0.01f;  // depth cameras' minimum range is centimetres
   const float min_depth = cloud.organized() ? kMinCameraDepthM : -kMaxCoordinate;
   auto bad = [min_depth](const Eigen::Vector3f& p) {
@@ -91,12 +91,11 @@ bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<std::array<SideKind, 4
 // plane the camera sees (a planar patch of at least floor_min_area_m2, and
 // three of the box's largest faces, whose plane lies farthest from the
 // camera along its normal: the floor or table under a pallet, a heap or a
-// bin), with no more than 1 % of the frame beyond it. A box with a corner more than floor_tolerance_m beyond it is taken
-// out: a "box" whose face is a pallet's deck board reaches its own height
-// into the floor. True when a box was taken out.
-bool CheckFloor(const DepthImage& depth, const DetectorOptions& options,
-                const FaceProposals& faces, std::vector<DetectedBox>* boxes,
-                std::vector<std::array<SideKind, 4>>* sides,
+// bin), with no more than 1 % of the frame beyond it. A box with a corner more than
+// floor_tolerance_m beyond it is taken out: a "box" whose face is a pallet's deck board reaches its
+// own height into the floor. True when a box was taken out.
+bool CheckFloor(const DepthImage& depth, const DetectorOptions& options, const FaceProposals& faces,
+                std::vector<DetectedBox>* boxes, std::vector<std::array<SideKind, 4>>* sides,
                 std::vector<DeclinedCandidate>* declined) {
   const BoxDims& d = options.box;
   const double largest_face = std::max({d.l * d.b, d.l * d.h, d.b * d.h});
@@ -139,9 +138,10 @@ bool CheckFloor(const DepthImage& depth, const DetectorOptions& options,
       deepest = std::max(deepest, -floor->normal.dot(corner - floor->centroid));
     }
     if (deepest <= options.floor_tolerance_m) return "";
-    return absl::StrFormat("the box would reach %.0f mm into the floor (a flat piece of "
-                           "something else of a face's size)",
-                           1000.0 * deepest);
+    return absl::StrFormat(
+        "the box would reach %.0f mm into the floor (a flat piece of "
+        "something else of a face's size)",
+        1000.0 * deepest);
   });
 }
 
@@ -164,7 +164,8 @@ bool CheckLayers(const DepthImage& depth, const DetectorOptions& options,
   std::vector<bool> tile(n, false);
   for (size_t i = 0; i < n; ++i) {
     const DetectedBox& b = (*boxes)[i];
-    layer[i] = LayerUnder(faces, depth, b.grasp_centre_camera, b.grasp_normal_camera, options.faces);
+    layer[i] =
+        LayerUnder(faces, depth, b.grasp_centre_camera, b.grasp_normal_camera, options.faces);
     if (layer[i] < 0) continue;
     tile[i] = IsLayerTile(faces.layers[layer[i]], options.box, b.camera_T_box, options.faces);
     const std::array<SideKind, 4>& s = (*sides)[i];
@@ -191,9 +192,9 @@ bool CheckLayers(const DepthImage& depth, const DetectorOptions& options,
 std::vector<DeclinedCandidate> StrongestDeclined(std::vector<DeclinedCandidate> all,
                                                  const std::vector<DetectedBox>& boxes,
                                                  const DetectorOptions& o) {
-  std::stable_sort(all.begin(), all.end(), [](const DeclinedCandidate& a, const DeclinedCandidate& b) {
-    return a.score > b.score;
-  });
+  std::stable_sort(
+      all.begin(), all.end(),
+      [](const DeclinedCandidate& a, const DeclinedCandidate& b) { return a.score > b.score; });
   std::vector<DeclinedCandidate> out;
   for (DeclinedCandidate& d : all) {
     if (static_cast<int>(out.size()) >= o.max_declined) break;
@@ -450,8 +451,9 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
     // get their turn, and what that accepts is checked again (a few rounds,
     // then a last check with nothing proposed).
     auto check = [&] {
-      const bool floor_removed = options.floor_check && CheckFloor(depth, options, faces,
-                                                                   &det.boxes, &sides_of, &declined);
+      const bool floor_removed =
+          options.floor_check &&
+          CheckFloor(depth, options, faces, &det.boxes, &sides_of, &declined);
       const bool layer_removed =
           options.faces.check_layer_tiling &&
           CheckLayers(depth, options, faces, &det.boxes, &sides_of, &declined);

@@ -1,8 +1,8 @@
 #include "common/perception/face_proposals.h"
 
 #include <algorithm>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "absl/strings/str_cat.h"
@@ -18,7 +18,7 @@ int FaceCount(double extent, double size, const FaceProposalOptions& o) {
   if (k < 1) return 0;
   const double slack = extent - k * size;
   return slack >= -o.size_tolerance_m && slack <= (k - 1) * o.max_gap_m + o.size_tolerance_m ? k
-                                                                                              : 0;
+                                                                                             : 0;
 }
 
 std::string Describe(const FaceTiling& t, const BoxDims& dims) {
@@ -58,8 +58,8 @@ Eigen::Isometry3d TilePose(const PlaneRectangle& rect, const FaceTiling& t, cons
   if (R.determinant() < 0.0) R.col(t.axis_v) = -rect.axis_v;  // the box is symmetric
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = R;
-  pose.translation() = rect.centre + u * rect.axis_u + v * rect.axis_v -
-                       0.5 * dims[t.normal_axis] * rect.normal;
+  pose.translation() =
+      rect.centre + u * rect.axis_u + v * rect.axis_v - 0.5 * dims[t.normal_axis] * rect.normal;
   return pose;
 }
 
@@ -164,8 +164,8 @@ double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const Fa
   (void)dims;
   if (!image.has_grey() || t.tiles() < 2) return 0.0;
   const double step_u = rect.width / t.count_u, step_v = rect.height / t.count_v;
-  const Eigen::Vector3d corner = rect.centre - 0.5 * rect.width * rect.axis_u -
-                                 0.5 * rect.height * rect.axis_v;
+  const Eigen::Vector3d corner =
+      rect.centre - 0.5 * rect.width * rect.axis_u - 0.5 * rect.height * rect.axis_v;
   int sides = 0, seams = 0;
   // Lines between columns (across u), one side per row; then between rows.
   for (int i = 1; i < t.count_u; ++i) {
@@ -211,10 +211,12 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     // A tile is proposed only where the patch is (a layer can be notched
     // where boxes were taken).
     auto on_patch = [&](const Eigen::Isometry3d& pose, const FaceTiling& t) {
-      const Eigen::Vector3d face_centre = pose.translation() + 0.5 * dims[t.normal_axis] * rect.normal;
+      const Eigen::Vector3d face_centre =
+          pose.translation() + 0.5 * dims[t.normal_axis] * rect.normal;
       if (face_centre.z() <= 0.05) return false;
       const Eigen::Vector2d px = Project(image.camera, face_centre);
-      const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+      const int u = static_cast<int>(std::lround(px.x())),
+                v = static_cast<int>(std::lround(px.y()));
       for (int dv = -1; dv <= 1; ++dv) {
         for (int du = -1; du <= 1; ++du) {
           if (patches.PatchAt(u + du * patches.step_px, v + dv * patches.step_px) ==
@@ -236,8 +238,11 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
       // Fill: the patch's area over that of the tiles on it (a layer with
       // boxes taken away is still full where it is); the least of the
       // tilings in play.
-      LayerTiles layer{static_cast<int>(id), std::numeric_limits<double>::max(), patch.normal,
-                       patch.centroid, {}};
+      LayerTiles layer{static_cast<int>(id),
+                       std::numeric_limits<double>::max(),
+                       patch.normal,
+                       patch.centroid,
+                       {}};
       for (const FaceTiling& t : in) {
         int present = 0;
         for (const Eigen::Isometry3d& pose : TilePoses(rect, t, dims)) {
@@ -359,8 +364,7 @@ int LayerUnder(const FaceProposals& faces, const DepthImage& image,
   for (size_t i = 0; i < faces.layers.size(); ++i) {
     const LayerTiles& layer = faces.layers[i];
     if (layer.patch != patch) continue;
-    if (layer.fill < o.layer_min_fill ||
-        std::abs(face_normal.dot(layer.normal)) < cos_max ||
+    if (layer.fill < o.layer_min_fill || std::abs(face_normal.dot(layer.normal)) < cos_max ||
         std::abs((face_centre - layer.centroid).dot(layer.normal)) > o.layer_match_m) {
       return -1;
     }

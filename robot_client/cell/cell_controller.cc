@@ -229,9 +229,10 @@ bool CellController::RobotReady() {
     std::unique_lock<std::mutex> lock(mutex_);
     if (!latched_fault_.empty()) {
       status_.awaiting_acknowledgement = true;
-      const std::string reason = absl::StrCat(
-          latched_fault_, " was reset; waiting for an operator's AcknowledgeFault before "
-                          "power-on and brake release");
+      const std::string reason =
+          absl::StrCat(latched_fault_,
+                       " was reset; waiting for an operator's AcknowledgeFault before "
+                       "power-on and brake release");
       lock.unlock();
       return Halt(reason);
     }
@@ -334,10 +335,10 @@ std::optional<CellController::PreparedPick> CellController::PreparePick(const Fr
     return std::nullopt;
   }
   if (!frame.box_dims || ((frame.box_dims->vec() - dims.vec()).cwiseAbs().maxCoeff() > 5e-4)) {
-    const std::string used =
-        frame.box_dims ? absl::StrCat(frame.box_dims->l, " x ", frame.box_dims->b, " x ",
-                                      frame.box_dims->h, " m")
-                       : std::string("unknown dimensions");
+    const std::string used = frame.box_dims
+                                 ? absl::StrCat(frame.box_dims->l, " x ", frame.box_dims->b, " x ",
+                                                frame.box_dims->h, " m")
+                                 : std::string("unknown dimensions");
     SetState(CellState::kStopped,
              absl::StrCat(frame_name, ": refused: detected with ", used, ", not the configured ",
                           dims.l, " x ", dims.b, " x ", dims.h, " m"));

@@ -73,8 +73,8 @@ absl::Time EffectiveDeadline(const grpc::CallbackServerContext& context,
 }
 
 grpc::Status RunDetect(grpc::CallbackServerContext& context, absl::Time deadline,
-                       const v1::DetectRequest& request,
-                       const DetectorOptions& defaults, const BoxModels& box_models,
+                       const v1::DetectRequest& request, const DetectorOptions& defaults,
+                       const BoxModels& box_models,
                        const std::map<std::string, std::unique_ptr<FrameSource>>& sources,
                        v1::DetectResponse& response) {
   if (grpc::Status s = CheckStillWanted(context, deadline); !s.ok()) return s;

@@ -14,7 +14,7 @@
 namespace cornerpose {
 namespace {
 
-constexpr double kTop = 1.2;    // camera to the layer's top, metres
+constexpr double kTop = 1.2;     // camera to the layer's top, metres
 constexpr double kFloor = 1.35;  // camera to the floor
 
 // A camera looking straight down at a rectangular layer (its top a plane at
@@ -43,7 +43,8 @@ struct LayerFrame {
         const Eigen::Vector3d ray = PixelRay(k, u, v);
         const Eigen::Vector2d q = ToLayer(ray.x() * kTop, ray.y() * kTop);
         const bool on_layer = std::abs(q.x()) <= width / 2 && std::abs(q.y()) <= height / 2;
-        image.z[static_cast<size_t>(v) * k.width + u] = static_cast<float>(on_layer ? kTop : kFloor);
+        image.z[static_cast<size_t>(v) * k.width + u] =
+            static_cast<float>(on_layer ? kTop : kFloor);
       }
     }
   }
@@ -200,9 +201,8 @@ TEST(FaceProposalsTest, ColourSeamsDecideBetweenTwoTilings) {
 // The line along a = 0 across the whole layer, from b = -h/2 to h/2.
 SeamCue CueAtMiddle(const LayerFrame& f) {
   return ColourSeamAlong(f.image, f.FromLayer(0.0, -f.height / 2, kTop),
-                         f.FromLayer(0.0, f.height / 2, kTop), f.FromLayer(1.0, 0.0, 0.0) -
-                                                                    f.FromLayer(0.0, 0.0, 0.0),
-                         SeamCueOptions{});
+                         f.FromLayer(0.0, f.height / 2, kTop),
+                         f.FromLayer(1.0, 0.0, 0.0) - f.FromLayer(0.0, 0.0, 0.0), SeamCueOptions{});
 }
 
 TEST(ColourSeamTest, ARealSeamRunningTheWholeSideIsASeam) {
@@ -231,10 +231,9 @@ TEST(ColourSeamTest, TheEdgeOfATapeStripIsNotASeam) {
   EXPECT_FALSE(CueAtMiddle(f).seam) << "coverage " << CueAtMiddle(f).coverage;
   SeamCueOptions steps;
   steps.accept_steps = true;
-  const SeamCue with_steps =
-      ColourSeamAlong(f.image, f.FromLayer(0.0, -f.height / 2, kTop),
-                      f.FromLayer(0.0, f.height / 2, kTop),
-                      f.FromLayer(1.0, 0.0, 0.0) - f.FromLayer(0.0, 0.0, 0.0), steps);
+  const SeamCue with_steps = ColourSeamAlong(
+      f.image, f.FromLayer(0.0, -f.height / 2, kTop), f.FromLayer(0.0, f.height / 2, kTop),
+      f.FromLayer(1.0, 0.0, 0.0) - f.FromLayer(0.0, 0.0, 0.0), steps);
   EXPECT_TRUE(with_steps.seam) << "coverage " << with_steps.coverage;
 }
 
@@ -245,7 +244,8 @@ TEST(ColourSeamTest, ALabelAcrossTheLineDoesNotMakeASeam) {
   f.Render();
   // A dark label 8 x 6 cm straddling a = 0 (its edges cross the line), and
   // a barcode-like block whose edge lies on the line over a third of it.
-  f.Paint({}, {}, {Eigen::Vector4d(-0.04, -0.08, 0.04, -0.02), Eigen::Vector4d(0.0, 0.02, 0.06, 0.085)});
+  f.Paint({}, {},
+          {Eigen::Vector4d(-0.04, -0.08, 0.04, -0.02), Eigen::Vector4d(0.0, 0.02, 0.06, 0.085)});
   const SeamCue cue = CueAtMiddle(f);
   EXPECT_FALSE(cue.seam) << "coverage " << cue.coverage;
   // Plain cardboard: nothing.

@@ -190,8 +190,7 @@ TEST(RegressionTest, AHoleLineOnHalfASideIsNoSeam) {
     for (Eigen::Vector3f& p : cloud.xyz) {
       if (!PointCloud::IsValid(p)) continue;
       const Eigen::Vector3d q = camera_T_true.inverse() * p.cast<double>();
-      if (std::abs(q.z() - 0.075) < 0.005 && std::abs(q.x()) < 0.002 && q.y() >= y0 &&
-          q.y() < y1) {
+      if (std::abs(q.z() - 0.075) < 0.005 && std::abs(q.x()) < 0.002 && q.y() >= y0 && q.y() < y1) {
         p = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
       }
     }

@@ -218,8 +218,8 @@ TEST_F(CellFaultTest, ReplaySourceIsRefusedUnlessAllowed) {
   options_.perception.allow_replay = false;
   StartCell();
   v1::CellStatus status;
-  ASSERT_TRUE(WaitForState(v1::CELL_STATE_STOPPED, "'cell' is a replay", absl::Seconds(30),
-                           &status))
+  ASSERT_TRUE(
+      WaitForState(v1::CELL_STATE_STOPPED, "'cell' is a replay", absl::Seconds(30), &status))
       << status.DebugString();
   EXPECT_TRUE(NoProgramSentFor(absl::Seconds(2)));
   EXPECT_EQ(status.picks_done(), 0u);

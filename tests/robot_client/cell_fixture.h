@@ -28,7 +28,9 @@
 
 namespace cornerpose::robot_client::testing {
 
-inline std::string CellFramesDir() { return std::string(CORNERPOSE_SOURCE_DIR) + "/data/frames/cell"; }
+inline std::string CellFramesDir() {
+  return std::string(CORNERPOSE_SOURCE_DIR) + "/data/frames/cell";
+}
 inline std::string ShippedCellConfig() {
   return std::string(CORNERPOSE_SOURCE_DIR) + "/deploy/config/robot_client.textproto";
 }

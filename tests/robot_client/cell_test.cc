@@ -30,15 +30,14 @@
 #include "robot_client/ur/dashboard_client.h"
 #include "robot_client/ur/pose.h"
 #include "server/server.h"
-#include "tests/support/ur_emulator/ur_emulator.h"
 #include "tests/robot_client/cell_fixture.h"
+#include "tests/support/ur_emulator/ur_emulator.h"
 
 namespace cornerpose::robot_client {
 namespace {
 
 const std::string kSourceDir = CORNERPOSE_SOURCE_DIR;
 const std::string kCellFrames = kSourceDir + "/data/frames/cell";
-
 
 struct GroundTruthBox {
   Eigen::Isometry3d camera_T_box = Eigen::Isometry3d::Identity();
@@ -319,9 +318,8 @@ TEST_F(CellTest, DroppedControllerConnectionsAreReopened) {
     // The drop hit a running pick: its end is unknown, the daemon stopped
     // the program on reconnect and sends nothing until an operator answers.
     EXPECT_EQ(status.state(), v1::CELL_STATE_STOPPED);
-    ASSERT_TRUE(
-        WaitForStatus([](const v1::CellStatus& s) { return s.awaiting_acknowledgement(); },
-                      absl::Seconds(30), &status))
+    ASSERT_TRUE(WaitForStatus([](const v1::CellStatus& s) { return s.awaiting_acknowledgement(); },
+                              absl::Seconds(30), &status))
         << status.DebugString();
     EXPECT_FALSE(emulator_->Snapshot().program_running);
     EXPECT_TRUE(NoProgramSentFor(absl::Seconds(1)));

@@ -2,6 +2,8 @@
 // web/README.md on a recorded frame, the frame's image and cloud, the event
 // stream, errors, the embedded page, /api/cell and /metrics moving as
 // requests are made.
+#include "server/http/http_server.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -13,7 +15,6 @@
 #include <string>
 #include <thread>
 
-#include "server/http/http_server.h"
 #include "server/server.h"
 // After Eigen (through server.h): httplib.h pulls in <resolv.h>, whose _res
 // macro breaks Eigen's headers included after it.
@@ -156,8 +157,8 @@ TEST_F(HttpServerTest, EventsPushDetectionsOfNewFrames) {
   std::string received;
   std::vector<uint64_t> ids;
   // Reads until two detection events came (the receiver stops the stream).
-  httplib::Result res = client_->Get(
-      "/api/sources/one/events", [&](const char* data, size_t length) {
+  httplib::Result res =
+      client_->Get("/api/sources/one/events", [&](const char* data, size_t length) {
         received.append(data, length);
         size_t at = 0;
         ids.clear();
@@ -226,7 +227,8 @@ TEST(HttpsTest, ServesOverTlsWithTheGivenCertificate) {
   const std::string key = (dir / "key.pem").string();
   const std::string command =
       "openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=127.0.0.1 "
-      "-addext subjectAltName=IP:127.0.0.1 -keyout " + key + " -out " + cert + " 2>/dev/null";
+      "-addext subjectAltName=IP:127.0.0.1 -keyout " +
+      key + " -out " + cert + " 2>/dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
 
   DetectionPool pool(1);
@@ -273,8 +275,12 @@ TEST_F(HttpServerTest, MetricsCountViewDetectionsAndHttpRequests) {
   const std::string after = Metrics();
   EXPECT_GE(Sample(after, R"(cornerpose_detections_total{origin="view"})"),
             Sample(before, R"(cornerpose_detections_total{origin="view"})") + 1);
-  EXPECT_EQ(Sample(after, R"(cornerpose_http_requests_total{route="/api/sources/{name}/latest",status="404"})"),
-            Sample(before, R"(cornerpose_http_requests_total{route="/api/sources/{name}/latest",status="404"})") + 1);
+  EXPECT_EQ(
+      Sample(after,
+             R"(cornerpose_http_requests_total{route="/api/sources/{name}/latest",status="404"})"),
+      Sample(before,
+             R"(cornerpose_http_requests_total{route="/api/sources/{name}/latest",status="404"})") +
+          1);
   EXPECT_EQ(Sample(after, R"(cornerpose_source_state{source="one",state="RUNNING"})"), 1);
   EXPECT_GE(Sample(after, R"(cornerpose_detection_stage_seconds_count{stage="total"})"), 1);
 }

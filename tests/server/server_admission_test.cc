@@ -119,7 +119,7 @@ TEST_F(AdmissionTest, FullQueueIsResourceExhaustedAndServingResumes) {
   options.max_queued_detections = 1;
   Start(options);
   Blocker blocker;
-  ASSERT_TRUE(blocker.Occupy(server_->pool()));                    // the worker
+  ASSERT_TRUE(blocker.Occupy(server_->pool()));                     // the worker
   ASSERT_TRUE(blocker.Occupy(server_->pool(), /*running=*/false));  // the one queue slot
   EXPECT_FALSE(server_->pool().TrySubmit([] {}));
 
@@ -357,8 +357,8 @@ TEST(AdmissionOptionsTest, ValidateNamesTheField) {
 }
 
 TEST(AdmissionOptionsTest, ConfigFileValuesAreReadAndChecked) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
-                                    ("admission_config_" + std::to_string(::getpid()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("admission_config_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "server.textproto").string();
   std::ofstream(path) << "max_queued_detections: 3\nmax_streams: 4\ndefault_deadline_ms: 500\n"

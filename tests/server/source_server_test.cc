@@ -145,8 +145,7 @@ TEST_F(ConnectionAgeTest, StreamsOutliveTheAgeAndLaterCallsReconnect) {
   v1::DetectResponse response;
   // Well past twice the age, and a few frames (a busy machine detects
   // slower than the source plays): the stream is never cut.
-  while (std::chrono::steady_clock::now() - start < std::chrono::milliseconds(2500) ||
-         frames < 4) {
+  while (std::chrono::steady_clock::now() - start < std::chrono::milliseconds(2500) || frames < 4) {
     ASSERT_TRUE(reader->Read(&response)) << "stream cut after " << frames << " frames";
     ++frames;
   }

@@ -18,7 +18,8 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 // The second camera's (or the projector's) shadow.
 constexpr PixelStatus kOccluded = kShadow;
 
-void Filter1d(std::vector<double>* values, int width, int height, int r, bool along_x, bool take_min) {
+void Filter1d(std::vector<double>* values, int width, int height, int r, bool along_x,
+              bool take_min) {
   if (r <= 0) return;
   const std::vector<double> in = *values;
   const int n_outer = along_x ? height : width, n_inner = along_x ? width : height;
@@ -128,7 +129,8 @@ std::vector<double> ApplyStereoNoise(const RayCaster& caster, const SurfaceTextu
         const int i = v * width + u;
         if (before[i] != kValid) continue;
         // A background pixel just left of an occluded run, within the margin.
-        const int margin = std::max<int>(0, std::lround(options.occlusion_margin_px + 1.5 * ragged[i]));
+        const int margin =
+            std::max<int>(0, std::lround(options.occlusion_margin_px + 1.5 * ragged[i]));
         for (int k = 1; k <= margin && u + k < width; ++k) {
           if (before[i + k] == kOccluded) {
             status[i] = kOccluded;
@@ -143,11 +145,11 @@ std::vector<double> ApplyStereoNoise(const RayCaster& caster, const SurfaceTextu
   // 5. Disparity noise, correlated over the matching window.
   const std::vector<double> window =
       SmoothGaussianField(width, height, options.window_correlation_px, rng);
-  const std::vector<double> blob = SmoothGaussianField(width, height, options.blob_correlation_px, rng);
+  const std::vector<double> blob =
+      SmoothGaussianField(width, height, options.blob_correlation_px, rng);
   std::normal_distribution<double> normal;
   const double w_white = std::sqrt(options.white_share), w_window = std::sqrt(options.window_share);
-  const double w_blob =
-      std::sqrt(std::max(0.0, 1.0 - options.white_share - options.window_share));
+  const double w_blob = std::sqrt(std::max(0.0, 1.0 - options.white_share - options.window_share));
   for (int i = 0; i < n; ++i) {
     if (status[i] != kValid) continue;
     const int u = i % width, v = i / width;

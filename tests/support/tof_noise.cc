@@ -141,8 +141,7 @@ std::vector<double> ApplyTofNoise(const RayCaster& caster, const SurfaceTexture&
         if (cos_q_cam <= 1e-3) continue;
         const double area = sample_px * q.z() * q.z() / (camera.fx * camera.fx) / cos_q_cam;
         // Irradiance at q (its amplitude) reflected diffusely towards p.
-        const double w =
-            amplitude[j] / std::numbers::pi * cos_p * cos_q / (dist * dist) * area;
+        const double w = amplitude[j] / std::numbers::pi * cos_p * cos_q / (dist * dist) * area;
         ratio += w;
         excess += w * 0.5 * (q.norm() + dist - p.norm());
       }

@@ -32,7 +32,8 @@ ABSL_FLAG(double, gap, 0.003, "Gap between pallet boxes, metres.");
 ABSL_FLAG(uint32_t, seed, 1, "Layout and noise seed.");
 ABSL_FLAG(std::string, sensor, "kinect", "Depth sensor model: kinect or ideal.");
 ABSL_FLAG(std::string, frames_dir, "out/sim/frames", "Where the camera writes its frames.");
-ABSL_FLAG(int, keep_frames, 4, "Frames kept in --frames_dir (the newest); more to look at a run afterwards.");
+ABSL_FLAG(int, keep_frames, 4,
+          "Frames kept in --frames_dir (the newest); more to look at a run afterwards.");
 ABSL_FLAG(double, camera_max_fps, 10, "Most renders a second (wall); only when the world changed.");
 ABSL_FLAG(double, camera_height, 2.0, "Camera height above the floor, metres.");
 ABSL_FLAG(std::string, host, "127.0.0.1", "Address the emulator listens on.");
@@ -44,7 +45,8 @@ ABSL_FLAG(bool, collisions, true, "Check the arm and the held box for contact.")
 ABSL_FLAG(std::string, report, "", "JSON report, rewritten after every pick.");
 ABSL_FLAG(std::string, write_robot_config, "",
           "Write the daemon's configuration for this cell (textproto) to this file.");
-ABSL_FLAG(std::string, source, "sim", "The perception source name the daemon's configuration uses.");
+ABSL_FLAG(std::string, source, "sim",
+          "The perception source name the daemon's configuration uses.");
 ABSL_FLAG(bool, config_only, false, "Write --write_robot_config and exit.");
 ABSL_FLAG(int, protective_stop_after, 0,
           "Fault injection: once this many boxes are placed, a protective stop on the arm "
@@ -71,12 +73,15 @@ nlohmann::json ReportJson(const std::string& description, const cell_sim::WorldS
   nlohmann::json box_list = nlohmann::json::array();
   for (const auto& b : boxes) {
     const Eigen::Vector3d t = b.world_T_box.translation();
-    box_list.push_back({{"id", b.id}, {"state", cell_sim::BoxStateName(b.state)},
+    box_list.push_back({{"id", b.id},
+                        {"state", cell_sim::BoxStateName(b.state)},
                         {"centre", {t.x(), t.y(), t.z()}}});
   }
-  return {{"scene", description}, {"boxes_total", s.boxes_total}, {"in_pile", s.in_pile},
-          {"placed", s.placed},   {"dropped", s.dropped},         {"held", s.held},
-          {"collisions", s.collisions}, {"picks", picks},        {"boxes", box_list}};
+  return {{"scene", description},       {"boxes_total", s.boxes_total},
+          {"in_pile", s.in_pile},       {"placed", s.placed},
+          {"dropped", s.dropped},       {"held", s.held},
+          {"collisions", s.collisions}, {"picks", picks},
+          {"boxes", box_list}};
 }
 
 void WriteAtomically(const std::string& path, const std::string& text) {
@@ -176,13 +181,15 @@ int main(int argc, char** argv) {
     const int failed = static_cast<int>(std::count_if(s.picks.begin(), s.picks.end(), [](auto& e) {
       return e.result != cell_sim::PickResult::kPlaced;
     }));
-    std::printf("sim %s: %s%s%s (arm %.1f s, waited %.2f s) | placed %d of %d, %d left, %d failed, "
-                "%d collisions\n",
-                p.program.c_str(), cell_sim::PickResultName(p.result),
-                p.detail.empty() ? "" : ": ", p.detail.c_str(), p.end_time_s - p.start_time_s,
-                p.wait_before_s, s.placed, s.boxes_total, s.in_pile, failed, s.collisions);
+    std::printf(
+        "sim %s: %s%s%s (arm %.1f s, waited %.2f s) | placed %d of %d, %d left, %d failed, "
+        "%d collisions\n",
+        p.program.c_str(), cell_sim::PickResultName(p.result), p.detail.empty() ? "" : ": ",
+        p.detail.c_str(), p.end_time_s - p.start_time_s, p.wait_before_s, s.placed, s.boxes_total,
+        s.in_pile, failed, s.collisions);
     std::fflush(stdout);
-    if (!report.empty()) WriteAtomically(report, ReportJson(description, s, world->Boxes()).dump(1));
+    if (!report.empty())
+      WriteAtomically(report, ReportJson(description, s, world->Boxes()).dump(1));
     if (stop_after > 0 && s.placed == stop_after && p.result == cell_sim::PickResult::kPlaced) {
       stop_armed = true;
     }
@@ -192,12 +199,13 @@ int main(int argc, char** argv) {
   }
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
-  std::printf("cell_sim: %s; %s on %s, dashboard %d, primary %d, rtde %d, time scale %g; camera "
-              "%.2f m above the pallet, %s model, frames in %s\n",
-              description.c_str(), ur::ArmModelName(options.model), options.host.c_str(),
-              (*emulator)->dashboard_port(), (*emulator)->primary_port(), (*emulator)->rtde_port(),
-              options.time_scale, cell_options.camera_height_m, camera_options.sensor.c_str(),
-              camera_options.directory.c_str());
+  std::printf(
+      "cell_sim: %s; %s on %s, dashboard %d, primary %d, rtde %d, time scale %g; camera "
+      "%.2f m above the pallet, %s model, frames in %s\n",
+      description.c_str(), ur::ArmModelName(options.model), options.host.c_str(),
+      (*emulator)->dashboard_port(), (*emulator)->primary_port(), (*emulator)->rtde_port(),
+      options.time_scale, cell_options.camera_height_m, camera_options.sensor.c_str(),
+      camera_options.directory.c_str());
   std::fflush(stdout);
   bool stop_injected = false;
   while (!g_stop) {

@@ -81,7 +81,8 @@ absl::StatusOr<std::vector<testing::SceneBox>> HeapLoad(const SimCellOptions& ce
       }
     }
     const Eigen::Vector3d size = hi - lo;
-    if (size.x() > cell.pick_length_m - 2 * margin_m || size.y() > cell.heap_width_m - 2 * margin_m) {
+    if (size.x() > cell.pick_length_m - 2 * margin_m ||
+        size.y() > cell.heap_width_m - 2 * margin_m) {
       continue;
     }
     const Eigen::Vector3d shift(-0.5 * (lo.x() + hi.x()), -0.5 * (lo.y() + hi.y()), deck_z);
@@ -89,8 +90,8 @@ absl::StatusOr<std::vector<testing::SceneBox>> HeapLoad(const SimCellOptions& ce
     for (auto& b : boxes) b.world_T_box.pretranslate(shift);
     return boxes;
   }
-  return absl::InvalidArgumentError(absl::StrCat("no heap of ", load.heap_boxes,
-                                                 " boxes of this size fits the pick area"));
+  return absl::InvalidArgumentError(
+      absl::StrCat("no heap of ", load.heap_boxes, " boxes of this size fits the pick area"));
 }
 
 // A bin standing on the pallet deck: a floor and four walls around the area.
@@ -181,9 +182,9 @@ absl::StatusOr<SimCell> MakeSimCell(const SimCellOptions& cell, const SimLoadOpt
   int per_layer = 0;
   if (load.kind == "pallet") {
     out.boxes = PalletLoad(cell, load, &per_layer);
-    out.description = absl::StrFormat("pallet of %d layers (%s) of up to %d boxes %.3g x %.3g x %.3g m, %d boxes",
-                                      load.layers, load.pattern, per_layer, d.l, d.b, d.h,
-                                      static_cast<int>(out.boxes.size()));
+    out.description = absl::StrFormat(
+        "pallet of %d layers (%s) of up to %d boxes %.3g x %.3g x %.3g m, %d boxes", load.layers,
+        load.pattern, per_layer, d.l, d.b, d.h, static_cast<int>(out.boxes.size()));
   } else {
     const bool bin = load.kind == "bin";
     const double deck = testing::kEurPalletHeight + (bin ? 0.02 : 0.0);
@@ -198,7 +199,8 @@ absl::StatusOr<SimCell> MakeSimCell(const SimCellOptions& cell, const SimLoadOpt
                                       bin ? "bin with a heap" : "heap on the pallet",
                                       static_cast<int>(out.boxes.size()), d.l, d.b, d.h, load.seed);
   }
-  if (out.boxes.empty()) return absl::InvalidArgumentError("no box of this size fits the pick area");
+  if (out.boxes.empty())
+    return absl::InvalidArgumentError("no box of this size fits the pick area");
 
   // The place pattern: the largest grid with 1 cm between boxes on the
   // place pallet's area, flat (the face picked looks up again), far row first.
@@ -217,8 +219,7 @@ absl::StatusOr<SimCell> MakeSimCell(const SimCellOptions& cell, const SimLoadOpt
                                      place_y - 0.5 * (out.place_rows - 1) * py,
                                      testing::kEurPalletHeight);
   out.place_origin_base = layout.world_T_base.inverse() * origin_world;
-  out.lift_height_m =
-      std::max(0.35, (load.kind == "pallet" ? d.h : d.vec().maxCoeff()) + 0.20);
+  out.lift_height_m = std::max(0.35, (load.kind == "pallet" ? d.h : d.vec().maxCoeff()) + 0.20);
   return out;
 }
 
@@ -244,9 +245,8 @@ absl::StatusOr<std::string> RobotClientConfigText(const SimCell& cell, const std
 
   std::string text = absl::StrCat(
       "# cornerpose_robot_client configuration for the simulated cell (written by\n",
-      "# cell_sim --write_robot_config; tests/support/cell_sim/sim_cell.h): ",
-      cell.description, ".\n",
-      "# A ", ur::ArmModelName(layout.arm),
+      "# cell_sim --write_robot_config; tests/support/cell_sim/sim_cell.h): ", cell.description,
+      ".\n", "# A ", ur::ArmModelName(layout.arm),
       " on a pedestal between the pick pallet (base +y, under the camera) and the\n",
       "# place pallet (base -y). Metres, radians, seconds.\n\n",
       "perception {\n  server_address: \"localhost:50051\"\n  source: \"", source, "\"\n  ",
@@ -256,8 +256,7 @@ absl::StatusOr<std::string> RobotClientConfigText(const SimCell& cell, const std
       "  rtde_frequency_hz: 125\n  connect_timeout_s: 5\n",
       "  # A simulated arm with no one near it: power on and release the brakes at\n",
       "  # start (a real cell leaves this off; see deploy/config/robot_client.textproto).\n",
-      "  bring_up_at_start: true\n}\n\n",
-      "# The camera straight above the pick pallet.\n",
+      "  bring_up_at_start: true\n}\n\n", "# The camera straight above the pick pallet.\n",
       "base_pose_camera {\n  position { x: ", Num(c.x()), " y: ", Num(c.y()), " z: ", Num(c.z()),
       " }\n  orientation { w: ", Num(q.w()), " x: ", Num(q.x()), " y: ", Num(q.y()),
       " z: ", Num(q.z()), " }\n}\n\n",
@@ -271,17 +270,16 @@ absl::StatusOr<std::string> RobotClientConfigText(const SimCell& cell, const std
       "# The held box rises this far above its grasp (its bottom clears the boxes\n",
       "# around it by 0.2 m or more) and comes down onto its slot from as high, so\n",
       "# it never sweeps through the layer it joins.\n",
-      "waypoints {\n  approach_distance_m: 0.10\n  retrieve_height_m: ",
-      Num(cell.lift_height_m), "\n  place_approach_height_m: ", Num(cell.lift_height_m),
-      "\n}\n\n",
+      "waypoints {\n  approach_distance_m: 0.10\n  retrieve_height_m: ", Num(cell.lift_height_m),
+      "\n  place_approach_height_m: ", Num(cell.lift_height_m), "\n}\n\n",
       "# Every box has a slot on the place pallet: far row first, then towards\n# the robot.\n",
       "place_pattern {\n  origin {\n    position { x: ", Num(cell.place_origin_base.x()),
       " y: ", Num(cell.place_origin_base.y()), " z: ", Num(cell.place_origin_base.z()),
       " }\n    orientation { w: 1 x: 0 y: 0 z: 0 }\n  }\n  rows: ", cell.place_rows,
       "\n  columns: ", cell.place_columns, "\n  layers: ", cell.place_layers,
-      "\n  spacing_x_m: ", Num(cell.place_spacing_x_m), "\n  spacing_y_m: ",
-      Num(cell.place_spacing_y_m), "\n  layer_height_m: ", Num(cell.place_layer_height_m),
-      "\n}\n\n",
+      "\n  spacing_x_m: ", Num(cell.place_spacing_x_m),
+      "\n  spacing_y_m: ", Num(cell.place_spacing_y_m),
+      "\n  layer_height_m: ", Num(cell.place_layer_height_m), "\n}\n\n",
       "# Free moves at two thirds of the UR5e's joint speed limit (pi rad/s).\n",
       "motion {\n  joint_speed_rad_s: 2.0\n  joint_acceleration_rad_s2: 3.0\n",
       "  linear_speed_m_s: 0.25\n  linear_acceleration_m_s2: 1.0\n}\n\n",
