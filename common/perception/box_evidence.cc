@@ -53,8 +53,8 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
   const Eigen::Vector3d half = 0.5 * dims.vec();
   // The ray through pixel (u, v) enters the box at depth *t through face
   // *face; false when it misses.
-  auto cast = [&](double u, double v, double* t, int* face) {
-    const Eigen::Vector3d dir = box_R_camera * PixelRay(k, u, v);
+  auto cast_ray = [&](const Eigen::Vector3d& ray, double* t, int* face) {
+    const Eigen::Vector3d dir = box_R_camera * ray;
     double t_near = -std::numeric_limits<double>::max(),
            t_far = std::numeric_limits<double>::max();
     int near_axis = -1;
@@ -78,6 +78,13 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
     *face = 2 * near_axis + (dir[near_axis] < 0.0 ? 0 : 1);
     return true;
   };
+  auto cast = [&](double u, double v, double* t, int* face) {
+    return cast_ray(PixelRay(k, u, v), t, face);
+  };
+  // The rays' x per column and y per row of the rectangle (PixelRay's values).
+  std::vector<double> ray_x(ub - ua + 1), ray_y(vb - va + 1);
+  for (int u = ua; u <= ub; ++u) ray_x[u - ua] = PixelRay(k, u, 0).x();
+  for (int v = va; v <= vb; ++v) ray_y[v - va] = PixelRay(k, 0, v).y();
   // The outline margin in pixels at the box's depth.
   const double margin_px =
       options.outline_margin_m > 0.0
@@ -98,7 +105,7 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
     for (int u = ua; u <= ub; u += step) {
       double z_model;
       int face;
-      if (!cast(u, v, &z_model, &face)) continue;
+      if (!cast_ray(Eigen::Vector3d(ray_x[u - ua], ray_y[v - va], 1.0), &z_model, &face)) continue;
       FaceEvidence& f = ev.faces[face];
       ++face_px[face];
       const float z = depth.at(u, v);

@@ -52,7 +52,8 @@ FaceFrame MakeFaceFrame(const Eigen::Isometry3d& camera_T_box, const BoxDims& di
 // Measured points near the face, in face coordinates.
 // Points in front of the plane (an occluder) go to `front`; where every
 // pixel's ray meets the plane goes to `grid` (what a fully seen face would
-// give: the reference for point densities).
+// give: the reference for point densities), within `margin` of a side only,
+// since only the seam scan along the sides reads it.
 std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margin,
                                          double plane_tol, std::vector<FacePoint>* front,
                                          std::vector<FacePoint>* grid) {
@@ -67,14 +68,24 @@ std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFram
   if (!rect) return {};
   const int ua = rect->u0, ub = rect->u1, va = rect->v0, vb = rect->v1;
   std::vector<FacePoint> pts;
+  const size_t area = static_cast<size_t>(ub - ua + 1) * (vb - va + 1);
+  pts.reserve(area);
+  grid->reserve(area / 2);
   const double n_dot_c = f.n.dot(f.c);
+  // The rays' x per column and y per row: the same values PixelRay() gives,
+  // without two divisions per pixel.
+  std::vector<double> ray_x(ub - ua + 1), ray_y(vb - va + 1);
+  for (int u = ua; u <= ub; ++u) ray_x[u - ua] = PixelRay(k, u, 0).x();
+  for (int v = va; v <= vb; ++v) ray_y[v - va] = PixelRay(k, 0, v).y();
   for (int v = va; v <= vb; ++v) {
     for (int u = ua; u <= ub; ++u) {
-      const Eigen::Vector3d ray = PixelRay(k, u, v);
+      const Eigen::Vector3d ray(ray_x[u - ua], ray_y[v - va], 1.0);
       if (const double n_dot_r = f.n.dot(ray); std::abs(n_dot_r) > 1e-6) {
         const Eigen::Vector3d g = (n_dot_c / n_dot_r) * ray - f.c;
         const FacePoint q{g.dot(f.a), g.dot(f.b), 0.0};
-        if (std::abs(q.a) <= f.half_a + margin && std::abs(q.b) <= f.half_b + margin) {
+        const double qa = std::abs(q.a), qb = std::abs(q.b);
+        if (qa <= f.half_a + margin && qb <= f.half_b + margin &&
+            (qa > f.half_a - margin || qb > f.half_b - margin)) {
           grid->push_back(q);
         }
       }
@@ -110,45 +121,57 @@ struct SideMeasure {
 // seam_search_m of the hypothesised side: the Kinect's depth noise is
 // spatially correlated, and a dip searched for everywhere is often noise.
 // Returns the seam's position (outward coordinate) or nothing.
-// The seam test over the points of one stretch of a side (along in
-// [along_lo, along_hi)): strength(c) > 0 where a seam shows at offset c.
+// The seam test over the points of one stretch of a side: strength(c) > 0
+// where a seam shows at offset c. Built once for the whole side, sorted;
+// a stretch (along in [along_lo, along_hi)) is a filtered copy, which keeps
+// the order, so it needs no sort of its own.
 class SeamScan {
  public:
   SeamScan(const std::vector<FacePoint>& pts, const std::vector<FacePoint>& grid, bool along_a,
-           double sign, double half, double half_other, double pixel_m, double along_lo,
-           double along_hi, const RefinementOptions& o)
+           double sign, double half, double half_other, double pixel_m, const RefinementOptions& o)
       : o_(o) {
     const double reach = o.side_band_m;
-    auto band = [&](const FacePoint& p, double* across) {
+    auto band = [&](const FacePoint& p, double* across, double* along) {
       *across = sign * (along_a ? p.a : p.b) - half;
-      const double along = along_a ? p.b : p.a;
-      return std::abs(along) <= half_other - reach && along >= along_lo && along < along_hi &&
-             std::abs(*across) < reach;
+      *along = along_a ? p.b : p.a;
+      return std::abs(*along) <= half_other - reach && std::abs(*across) < reach;
     };
-    std::vector<std::pair<double, double>> rows;  // (across - half, height)
+    std::vector<Row> rows;
     for (const FacePoint& p : pts) {
-      double across;
-      if (band(p, &across)) rows.emplace_back(across, p.n);
+      double across, along;
+      if (band(p, &across, &along)) rows.push_back({across, p.n, along});
     }
     for (const FacePoint& p : grid) {  // where pixels meet the plane, same band
-      double across;
-      if (band(p, &across)) expected_.push_back(across);
+      double across, along;
+      if (band(p, &across, &along)) expected_.push_back({across, along});
     }
     std::sort(expected_.begin(), expected_.end());
     std::sort(rows.begin(), rows.end());
-    xs_.resize(rows.size());
-    prefix_.assign(rows.size() + 1, 0.0);
-    for (size_t i = 0; i < rows.size(); ++i) {
-      xs_[i] = rows[i].first;
-      prefix_[i + 1] = prefix_[i] + rows[i].second;
-    }
+    rows_ = std::move(rows);
+    Index();
     w_ = std::max(0.003, 2.5 * pixel_m);  // centre window width
     f0_ = w_ / 2 + pixel_m;               // flanks
     f1_ = w_ / 2 + 6 * pixel_m;
   }
 
+  // The points of this side with along in [lo, hi).
+  SeamScan Stretch(double lo, double hi) const {
+    SeamScan part(o_);
+    for (const Row& r : rows_) {
+      if (r.along >= lo && r.along < hi) part.rows_.push_back(r);
+    }
+    for (const auto& e : expected_) {
+      if (e.second >= lo && e.second < hi) part.expected_.push_back(e);
+    }
+    part.Index();
+    part.w_ = w_;
+    part.f0_ = f0_;
+    part.f1_ = f1_;
+    return part;
+  }
+
   size_t points() const { return xs_.size(); }
-  size_t expected() const { return expected_.size(); }
+  size_t expected() const { return expected_x_.size(); }
 
   // How far past its threshold the strongest test is at offset c (<= 0: no
   // seam there); nullopt when too few points to say.
@@ -175,6 +198,24 @@ class SeamScan {
   }
 
  private:
+  struct Row {
+    double across, height, along;  // across: offset from the side
+    bool operator<(const Row& r) const {
+      return across != r.across ? across < r.across : height < r.height;
+    }
+  };
+  explicit SeamScan(const RefinementOptions& o) : o_(o) {}
+
+  void Index() {
+    xs_.resize(rows_.size());
+    prefix_.assign(rows_.size() + 1, 0.0);
+    for (size_t i = 0; i < rows_.size(); ++i) {
+      xs_[i] = rows_[i].across;
+      prefix_[i + 1] = prefix_[i] + rows_[i].height;
+    }
+    expected_x_.resize(expected_.size());
+    for (size_t i = 0; i < expected_.size(); ++i) expected_x_[i] = expected_[i].first;
+  }
   // Count and height sum of points with across in [lo, hi).
   std::pair<double, double> Window(double lo, double hi) const {
     const size_t a = std::lower_bound(xs_.begin(), xs_.end(), lo) - xs_.begin();
@@ -182,12 +223,14 @@ class SeamScan {
     return {static_cast<double>(b - a), prefix_[b] - prefix_[a]};
   }
   double ExpectedIn(double lo, double hi) const {
-    return static_cast<double>(std::lower_bound(expected_.begin(), expected_.end(), hi) -
-                               std::lower_bound(expected_.begin(), expected_.end(), lo));
+    return static_cast<double>(std::lower_bound(expected_x_.begin(), expected_x_.end(), hi) -
+                               std::lower_bound(expected_x_.begin(), expected_x_.end(), lo));
   }
 
   const RefinementOptions& o_;
-  std::vector<double> xs_, prefix_, expected_;
+  std::vector<Row> rows_;
+  std::vector<std::pair<double, double>> expected_;  // (across, along)
+  std::vector<double> xs_, prefix_, expected_x_;
   double w_ = 0.0, f0_ = 0.0, f1_ = 0.0;
 };
 
@@ -196,7 +239,7 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
                                double half, double half_other, double pixel_m,
                                const RefinementOptions& o) {
   constexpr double kAll = std::numeric_limits<double>::infinity();
-  const SeamScan whole(pts, grid, along_a, sign, half, half_other, pixel_m, -kAll, kAll, o);
+  const SeamScan whole(pts, grid, along_a, sign, half, half_other, pixel_m, o);
   if (whole.points() < 50 || whole.expected() < 50) return std::nullopt;
   std::optional<double> best;
   double best_strength = 0.0;
@@ -216,7 +259,7 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
   // sums but not in both halves.
   if (o.seam_halves_min_strength > -1.0) {
     for (const auto& [lo, hi] : {std::pair{-kAll, 0.0}, std::pair{0.0, kAll}}) {
-      const SeamScan part(pts, grid, along_a, sign, half, half_other, pixel_m, lo, hi, o);
+      const SeamScan part = whole.Stretch(lo, hi);
       double strongest = -kAll;
       for (double c = *best - 0.001; c <= *best + 0.001 + 1e-9; c += 0.001) {
         if (const std::optional<double> st = part.Strength(c)) strongest = std::max(strongest, *st);

@@ -11,6 +11,10 @@
 #include <thread>
 #include <unordered_set>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include "absl/strings/str_cat.h"
 #include "common/perception/internal/parallel.h"
 
@@ -56,65 +60,47 @@ class OrganizedScorer {
         focal_px_(static_cast<float>(focal_px)),
         radius2_(static_cast<float>(options.radius_m * options.radius_m)),
         pattern_(UnitDiscPattern(std::max(options.max_samples, 1))) {
-    // Neighbour offsets per radius, in quarter pixels, as index deltas into
-    // the row-major grid: the inner loop is then a load and a distance.
-    for (int bucket = 0; bucket <= kMaxBucket; ++bucket) {
-      const float radius_px = bucket / 4.0f;
-      std::vector<int>& table = offsets_[bucket];
-      if (UseFullDisc(radius_px)) {
-        const int r = static_cast<int>(std::ceil(radius_px));
-        for (int dv = -r; dv <= r; ++dv) {
-          for (int du = -r; du <= r; ++du) {
-            if ((du != 0 || dv != 0) && du * du + dv * dv <= radius_px * radius_px) {
-              table.push_back(dv * cloud.width + du);
-            }
-          }
-        }
-      } else {
-        for (const Eigen::Vector2f& o : pattern_) {
-          const int du = static_cast<int>(std::lround(o.x() * radius_px));
-          const int dv = static_cast<int>(std::lround(o.y() * radius_px));
-          if (du != 0 || dv != 0) table.push_back(dv * cloud.width + du);
-        }
-      }
-    }
+    BuildOffsets(options.max_samples, &offsets_);
+    BuildOffsets(options.coarse_samples > 0 ? options.coarse_samples : options.max_samples,
+                 &coarse_offsets_);
   }
 
   // The score of pixel (u, v), or -1 where it is not scored (no return,
-  // neighbourhood cut by the frame, too few neighbours).
-  float ScoreAt(int u, int v) const {
+  // neighbourhood cut by the frame, too few neighbours); with `coarse`, from
+  // the coarse pass's fewer samples.
+  float ScoreAt(int u, int v, bool coarse = false) const {
     const Eigen::Vector3f& p = cloud_.xyz[v * cloud_.width + u];
     if (!PointCloud::IsValid(p) || p.z() <= 0.0f) return -1.0f;
     const float radius_px = static_cast<float>(options_.radius_m) * focal_px_ / p.z();
     if (CutByBorder(u, v, radius_px)) return -1.0f;
-    const NeighbourSum n = Neighbours(u, v, p, radius_px);
+    const NeighbourSum n = Neighbours(u, v, p, radius_px, coarse ? coarse_offsets_ : offsets_);
     if (n.count < options_.min_neighbours) return -1.0f;
     return n.Score();
   }
 
-  // Coarse pass: marks grid cells (step x step pixels) whose centre pixel
-  // scores above `threshold`.
-  void MarkCoarse(int cell_row_begin, int cell_row_end, int step, float threshold,
-                  std::vector<uint8_t>* marks) const {
+  // Coarse pass: the score of each grid cell's (step x step pixels) centre
+  // pixel, -1 where it is not scored.
+  void ScoreCoarse(int cell_row_begin, int cell_row_end, int step,
+                   std::vector<float>* cell_scores) const {
     const int cells_w = (cloud_.width + step - 1) / step;
     for (int cv = cell_row_begin; cv < cell_row_end; ++cv) {
       for (int cu = 0; cu < cells_w; ++cu) {
         const int u = std::min(cu * step + step / 2, cloud_.width - 1);
         const int v = std::min(cv * step + step / 2, cloud_.height - 1);
-        (*marks)[cv * cells_w + cu] = ScoreAt(u, v) > threshold;
+        (*cell_scores)[cv * cells_w + cu] = ScoreAt(u, v, /*coarse=*/true);
       }
     }
   }
 
-  // Full-resolution pass over rows; with `marks`, only pixels in or next to
-  // a marked cell are scored.
-  void ScoreRows(int row_begin, int row_end, int step, const std::vector<uint8_t>* marks,
+  // Full-resolution pass over rows; with `cells` (1: score the cell's
+  // pixels), only those pixels are scored.
+  void ScoreRows(int row_begin, int row_end, int step, const std::vector<uint8_t>* cells,
                  Chunk* out) const {
     const int w = cloud_.width;
-    const int cells_w = (w + step - 1) / step, cells_h = (cloud_.height + step - 1) / step;
+    const int cells_w = (w + step - 1) / step;
     for (int v = row_begin; v < row_end; ++v) {
       for (int u = 0; u < w; ++u) {
-        if (marks != nullptr && !NearMark(*marks, u / step, v / step, cells_w, cells_h)) continue;
+        if (cells != nullptr && !(*cells)[(v / step) * cells_w + u / step]) continue;
         const float score = ScoreAt(u, v);
         if (score <= options_.threshold) continue;
         const Eigen::Vector3f& p = cloud_.xyz[v * w + u];
@@ -129,19 +115,35 @@ class OrganizedScorer {
   }
 
  private:
-  static bool NearMark(const std::vector<uint8_t>& marks, int cu, int cv, int cells_w,
-                       int cells_h) {
-    for (int y = std::max(0, cv - 1); y <= std::min(cells_h - 1, cv + 1); ++y) {
-      for (int x = std::max(0, cu - 1); x <= std::min(cells_w - 1, cu + 1); ++x) {
-        if (marks[y * cells_w + x]) return true;
+  static constexpr int kMaxBucket = 256;
+  using OffsetTables = std::array<std::vector<int>, kMaxBucket + 1>;
+
+  // Neighbour offsets per radius, in quarter pixels, as index deltas into
+  // the row-major grid (the inner loop is then a load and a distance): the
+  // whole disc, or `samples` of it on a sunflower spiral when the disc holds
+  // more pixels than that (0: always the whole disc).
+  void BuildOffsets(int samples, OffsetTables* tables) const {
+    const std::vector<Eigen::Vector2f> pattern = UnitDiscPattern(std::max(samples, 1));
+    for (int bucket = 0; bucket <= kMaxBucket; ++bucket) {
+      const float radius_px = bucket / 4.0f;
+      std::vector<int>& table = (*tables)[bucket];
+      if (samples == 0 || std::numbers::pi_v<float> * radius_px * radius_px <= samples) {
+        const int r = static_cast<int>(std::ceil(radius_px));
+        for (int dv = -r; dv <= r; ++dv) {
+          for (int du = -r; du <= r; ++du) {
+            if ((du != 0 || dv != 0) && du * du + dv * dv <= radius_px * radius_px) {
+              table.push_back(dv * cloud_.width + du);
+            }
+          }
+        }
+      } else {
+        for (const Eigen::Vector2f& o : pattern) {
+          const int du = static_cast<int>(std::lround(o.x() * radius_px));
+          const int dv = static_cast<int>(std::lround(o.y() * radius_px));
+          if (du != 0 || dv != 0) table.push_back(dv * cloud_.width + du);
+        }
       }
     }
-    return false;
-  }
-
-  bool UseFullDisc(float radius_px) const {
-    return options_.max_samples == 0 ||
-           std::numbers::pi_v<float> * radius_px * radius_px <= options_.max_samples;
   }
 
   const Eigen::Vector3f* At(int u, int v) const {
@@ -155,31 +157,83 @@ class OrganizedScorer {
   // On a Kinect the point's own axial noise (2-4 mm) tilts every d_j the same
   // way and lifts a flat patch's score to ~0.2-0.4, so one in ten floor
   // points would pass t_h; the median offset is ~0 at a true edge.
-  NeighbourSum Neighbours(int u, int v, const Eigen::Vector3f& p, float radius_px) const {
-    thread_local std::vector<Eigen::Vector3f> found;
-    thread_local std::vector<float> dz;
-    found.clear();
+  NeighbourSum Neighbours(int u, int v, const Eigen::Vector3f& p, float radius_px,
+                          const OffsetTables& tables) const {
+    // The neighbours as structure of arrays (per thread, sized once): the
+    // unit vectors are then taken four at a time.
+    thread_local std::vector<float> fx, fy, fz, dz;
     const float reach2 = 2.25f * radius2_;  // 1.5 r_s: room for p's own noise
     // CutByBorder() has kept the whole disc inside the image.
     const Eigen::Vector3f* base = &cloud_.xyz[static_cast<size_t>(v) * cloud_.width + u];
     // Clamped before the cast: r fx / z is unbounded for a point near z = 0.
     const float quarter_px = radius_px * 4.0f + 0.5f;
     const int bucket = quarter_px < kMaxBucket ? static_cast<int>(quarter_px) : kMaxBucket;
-    for (const int off : offsets_[bucket]) {
+    const std::vector<int>& offsets = tables[bucket];
+    // Room for a whole block of four past the last neighbour.
+    if (fx.size() < offsets.size() + 4) {
+      for (std::vector<float>* a : {&fx, &fy, &fz, &dz}) a->resize(offsets.size() + 4);
+    }
+    size_t m = 0;
+    for (const int off : offsets) {
       const Eigen::Vector3f& q = base[off];
       if (!(q.z() == q.z())) continue;  // NaN: no return
-      if ((q - p).squaredNorm() <= reach2) found.push_back(q);
+      if ((q - p).squaredNorm() <= reach2) {
+        fx[m] = q.x();
+        fy[m] = q.y();
+        fz[m] = q.z();
+        ++m;
+      }
     }
     Eigen::Vector3f centre = p;
-    if (options_.denoise && found.size() >= 3) {
-      dz.clear();
-      for (const Eigen::Vector3f& q : found) dz.push_back(q.z() - p.z());
-      std::nth_element(dz.begin(), dz.begin() + dz.size() / 2, dz.end());
-      centre = p * ((p.z() + dz[dz.size() / 2]) / p.z());
+    if (options_.denoise && m >= 3) {
+      for (size_t k = 0; k < m; ++k) dz[k] = fz[k] - p.z();
+      std::nth_element(dz.begin(), dz.begin() + m / 2, dz.begin() + m);
+      centre = p * ((p.z() + dz[m / 2]) / p.z());
+    }
+    return UnitVectorSum(fx.data(), fy.data(), fz.data(), m, centre);
+  }
+
+  // The sum of the unit vectors from `centre` to the neighbours within r_s,
+  // in the neighbours' order. Each lane of the SSE path does the scalar
+  // path's operations in the same order (IEEE sqrt and division are exact to
+  // the bit), so both give the same score.
+  NeighbourSum UnitVectorSum(float* x, float* y, float* z, size_t m,
+                             const Eigen::Vector3f& centre) const {
+    size_t k = 0;
+#if defined(__SSE2__)
+    // x, y, z become the unit vector (or 0 where the neighbour is out of reach).
+    const __m128 cx = _mm_set1_ps(centre.x()), cy = _mm_set1_ps(centre.y()),
+                 cz = _mm_set1_ps(centre.z()), r2 = _mm_set1_ps(radius2_),
+                 zero = _mm_setzero_ps();
+    thread_local std::vector<uint8_t> within;
+    if (within.size() < m + 4) within.resize(m + 4);
+    for (; k + 4 <= m; k += 4) {
+      const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x + k), cx);
+      const __m128 dy = _mm_sub_ps(_mm_loadu_ps(y + k), cy);
+      const __m128 dzv = _mm_sub_ps(_mm_loadu_ps(z + k), cz);
+      const __m128 d2 =
+          _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dzv, dzv));
+      const int mask =
+          _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(d2, r2), _mm_cmpgt_ps(d2, zero)));
+      const __m128 len = _mm_sqrt_ps(d2);
+      _mm_storeu_ps(x + k, _mm_div_ps(dx, len));
+      _mm_storeu_ps(y + k, _mm_div_ps(dy, len));
+      _mm_storeu_ps(z + k, _mm_div_ps(dzv, len));
+      for (int l = 0; l < 4; ++l) within[k + l] = (mask >> l) & 1;
     }
     NeighbourSum n;
-    for (const Eigen::Vector3f& q : found) {
-      const Eigen::Vector3f d = q - centre;
+    for (size_t j = 0; j < k; ++j) {
+      if (!within[j]) continue;
+      n.sum.x() += x[j];
+      n.sum.y() += y[j];
+      n.sum.z() += z[j];
+      ++n.count;
+    }
+#else
+    NeighbourSum n;
+#endif
+    for (; k < m; ++k) {
+      const Eigen::Vector3f d = Eigen::Vector3f(x[k], y[k], z[k]) - centre;
       const float dist2 = d.squaredNorm();
       if (dist2 <= radius2_) n.Add(d, dist2);
     }
@@ -212,8 +266,7 @@ class OrganizedScorer {
   const std::vector<Eigen::Vector2f> pattern_;
   // Radii above kMaxBucket / 4 pixels (points nearer than ~0.17 m for the
   // default radius and a VGA camera) use the largest table.
-  static constexpr int kMaxBucket = 256;
-  std::array<std::vector<int>, kMaxBucket + 1> offsets_;
+  OffsetTables offsets_, coarse_offsets_;
 };
 
 EdgePoints Merge(const PointCloud& cloud, std::vector<Chunk>& chunks) {
@@ -239,17 +292,35 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
     return Merge(cloud, chunks);
   }
   // Coarse to fine: edge bands are several pixels wide, so a grid of one
-  // pixel in step x step finds every band; only pixels near a hit are then
-  // scored at full resolution, with the real threshold.
+  // pixel in step x step finds every band; the pixels of the hit cells and
+  // of the cells next to them that may hold a band's rim are then scored at
+  // full resolution, with the real threshold.
   const int cells_w = (cloud.width + step - 1) / step, cells_h = (cloud.height + step - 1) / step;
-  std::vector<uint8_t> marks(static_cast<size_t>(cells_w) * cells_h, 0);
-  const float coarse_threshold =
-      static_cast<float>(options.threshold * options.coarse_threshold_factor);
+  std::vector<float> cell_scores(static_cast<size_t>(cells_w) * cells_h, -1.0f);
   internal::ParallelForRanges(cells_h, options.num_threads, [&](int, int begin, int end) {
-    scorer.MarkCoarse(begin, end, step, coarse_threshold, &marks);
+    scorer.ScoreCoarse(begin, end, step, &cell_scores);
   });
+  const float hit = static_cast<float>(options.threshold * options.coarse_threshold_factor);
+  const float rim = static_cast<float>(options.threshold * options.coarse_skip_factor);
+  std::vector<uint8_t> cells(cell_scores.size(), 0);
+  for (int cv = 0; cv < cells_h; ++cv) {
+    for (int cu = 0; cu < cells_w; ++cu) {
+      const float own = cell_scores[cv * cells_w + cu];
+      if (own >= 0.0f && own <= rim && options.coarse_skip_factor > 0.0) continue;
+      bool near_hit = false;
+      for (int y = std::max(0, cv - 1); y <= std::min(cells_h - 1, cv + 1) && !near_hit; ++y) {
+        for (int x = std::max(0, cu - 1); x <= std::min(cells_w - 1, cu + 1); ++x) {
+          if (cell_scores[y * cells_w + x] > hit) {
+            near_hit = true;
+            break;
+          }
+        }
+      }
+      cells[cv * cells_w + cu] = near_hit;
+    }
+  }
   internal::ParallelForRanges(cloud.height, options.num_threads, [&](int t, int begin, int end) {
-    scorer.ScoreRows(begin, end, step, &marks, &chunks[t]);
+    scorer.ScoreRows(begin, end, step, &cells, &chunks[t]);
   });
   return Merge(cloud, chunks);
 }
@@ -367,6 +438,14 @@ absl::Status EdgePointOptions::Validate() const {
   if (!(coarse_threshold_factor > 0.0 && coarse_threshold_factor <= 1.0)) {
     return absl::InvalidArgumentError(absl::StrCat(
         "edge coarse_threshold_factor=", coarse_threshold_factor, " is outside (0, 1]"));
+  }
+  if (coarse_samples < 0 || coarse_samples > 4096) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("edge coarse_samples=", coarse_samples, " is outside [0, 4096]"));
+  }
+  if (!(coarse_skip_factor >= 0.0 && coarse_skip_factor <= 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("edge coarse_skip_factor=", coarse_skip_factor, " is outside [0, 1]"));
   }
   if (num_threads < 1 || num_threads > 256) {
     return absl::InvalidArgumentError(

@@ -123,6 +123,16 @@ class SegmentFitter {
     const float min2 = static_cast<float>(options_.sample_min_m * options_.sample_min_m);
     const float max2 = static_cast<float>(options_.sample_max_m * options_.sample_max_m);
     std::uniform_int_distribution<int> pick(0, static_cast<int>(alive.size()) - 1);
+    // The subset as structure of arrays: the count below is the stage's
+    // inner loop (iterations x subset), and in this layout it vectorizes.
+    sx_.resize(subset.size());
+    sy_.resize(subset.size());
+    sz_.resize(subset.size());
+    for (size_t k = 0; k < subset.size(); ++k) {
+      sx_[k] = pts_[subset[k]].x();
+      sy_[k] = pts_[subset[k]].y();
+      sz_[k] = pts_[subset[k]].z();
+    }
     std::optional<Line> best;
     int best_count = 0;
     std::vector<int> candidates;
@@ -140,14 +150,32 @@ class SegmentFitter {
       Line line;
       line.point = pts_[a];
       line.direction = (pts_[b] - pts_[a]).normalized();
-      int count = 0;
-      for (int i : subset) count += line.Distance2(pts_[i]) <= t2;
+      const int count = CountWithin(line, t2);
       if (count > best_count) {
         best_count = count;
         best = line;
       }
     }
     return best;
+  }
+
+  // Subset points within sqrt(t2) of the line: Line::Distance2 written out
+  // in the same order of operations, so the counts are the same.
+  int CountWithin(const Line& line, float t2) const {
+    const float px = line.point.x(), py = line.point.y(), pz = line.point.z();
+    const float dx = line.direction.x(), dy = line.direction.y(), dz = line.direction.z();
+    const size_t n = sx_.size();
+    const float* xs = sx_.data();
+    const float* ys = sy_.data();
+    const float* zs = sz_.data();
+    int count = 0;
+    for (size_t k = 0; k < n; ++k) {
+      const float ax = xs[k] - px, ay = ys[k] - py, az = zs[k] - pz;
+      const float t = ax * dx + ay * dy + az * dz;
+      const float ex = ax - t * dx, ey = ay - t * dy, ez = az - t * dz;
+      count += (ex * ex + ey * ey + ez * ez) <= t2;
+    }
+    return count;
   }
 
   std::vector<int> Inliers(const Line& line, float threshold) const {
@@ -255,6 +283,7 @@ class SegmentFitter {
   int num_alive_;
   Grid grid_;
   std::mt19937 rng_;
+  std::vector<float> sx_, sy_, sz_;  // the current RANSAC subset
 };
 
 }  // namespace
