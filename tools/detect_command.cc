@@ -49,6 +49,8 @@ constexpr char kHelp[] =
     "  --meet_distance M    corner: largest distance between two edges' lines (0.01)\n"
     "  --coarse_step N      organized frames: score 1 pixel in N x N first, then only\n"
     "                       pixels near a hit; 1 = every pixel (3)\n"
+    "  --lattice_radius PX  organized frames: the edge stage scores every k-th pixel,\n"
+    "                       k = r_s in pixels / PX at the median depth (0 = every pixel)\n"
     "  --denoise BOOL       score from the neighbours' median depth (true); false is\n"
     "                       the paper's formula exactly, for clouds not taken by a camera\n"
     "                       at the origin\n"
@@ -88,6 +90,7 @@ absl::Status Run(const CommandArgs& args) {
                          args.SetDouble("meet_distance", &options.clubbing.meet_distance_m),
                          args.SetInt("threads", &options.num_threads),
                          args.SetInt("coarse_step", &options.edge_points.coarse_step),
+                         args.SetDouble("lattice_radius", &options.edge_lattice_radius_px),
                          args.SetBool("denoise", &options.edge_points.denoise),
                          args.SetBool("faces", &options.face_proposals),
                          args.SetBool("layer_check", &options.faces.check_layer_tiling),
@@ -174,6 +177,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "meet_distance",
                                                        "threads",
                                                        "coarse_step",
+                                                       "lattice_radius",
                                                        "denoise",
                                                        "color",
                                                        "faces",

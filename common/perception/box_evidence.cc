@@ -53,6 +53,8 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
   const Eigen::Vector3d half = 0.5 * dims.vec();
   // The ray through pixel (u, v) enters the box at depth *t through face
   // *face; false when it misses.
+  // The slabs' planes relative to the ray origin, per axis.
+  const Eigen::Vector3d slab_lo = -half - origin, slab_hi = half - origin;
   auto cast_ray = [&](const Eigen::Vector3d& ray, double* t, int* face) {
     const Eigen::Vector3d dir = box_R_camera * ray;
     double t_near = -std::numeric_limits<double>::max(),
@@ -63,7 +65,8 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
         if (std::abs(origin[a]) > half[a]) return false;
         continue;
       }
-      double t1 = (-half[a] - origin[a]) / dir[a], t2 = (half[a] - origin[a]) / dir[a];
+      const double inv = 1.0 / dir[a];
+      double t1 = slab_lo[a] * inv, t2 = slab_hi[a] * inv;
       if (t1 > t2) std::swap(t1, t2);
       if (t1 > t_near) {
         t_near = t1;

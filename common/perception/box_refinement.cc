@@ -71,29 +71,39 @@ std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFram
   const size_t area = static_cast<size_t>(ub - ua + 1) * (vb - va + 1);
   pts.reserve(area);
   grid->reserve(area / 2);
-  const double n_dot_c = f.n.dot(f.c);
-  // The rays' x per column and y per row: the same values PixelRay() gives,
-  // without two divisions per pixel.
-  std::vector<double> ray_x(ub - ua + 1), ray_y(vb - va + 1);
-  for (int u = ua; u <= ub; ++u) ray_x[u - ua] = PixelRay(k, u, 0).x();
-  for (int v = va; v <= vb; ++v) ray_y[v - va] = PixelRay(k, 0, v).y();
+  // Per pixel ray r = (x_u, y_v, 1), the face coordinates are linear in r:
+  // a measured point z r has a = z (a.r) - a.c (and b, n alike), and the ray
+  // meets the plane at s r with s = (n.c) / (n.r). The dot products with r
+  // are a per-column term plus a per-row one, so a pixel costs a few
+  // multiplications and one division.
+  const double a_c = f.a.dot(f.c), b_c = f.b.dot(f.c), n_c = f.n.dot(f.c);
+  std::vector<double> a_x(ub - ua + 1), b_x(ub - ua + 1), n_x(ub - ua + 1);
+  for (int u = ua; u <= ub; ++u) {
+    const double x = PixelRay(k, u, 0).x();
+    a_x[u - ua] = f.a.x() * x;
+    b_x[u - ua] = f.b.x() * x;
+    n_x[u - ua] = f.n.x() * x;
+  }
+  const double lim_a = f.half_a + margin, lim_b = f.half_b + margin;
+  const double in_a = f.half_a - margin, in_b = f.half_b - margin;
   for (int v = va; v <= vb; ++v) {
+    const double y = PixelRay(k, 0, v).y();
+    const double a_row = f.a.y() * y + f.a.z(), b_row = f.b.y() * y + f.b.z(),
+                 n_row = f.n.y() * y + f.n.z();
+    const float* zrow = &depth.z[static_cast<size_t>(v) * k.width];
     for (int u = ua; u <= ub; ++u) {
-      const Eigen::Vector3d ray(ray_x[u - ua], ray_y[v - va], 1.0);
-      if (const double n_dot_r = f.n.dot(ray); std::abs(n_dot_r) > 1e-6) {
-        const Eigen::Vector3d g = (n_dot_c / n_dot_r) * ray - f.c;
-        const FacePoint q{g.dot(f.a), g.dot(f.b), 0.0};
+      const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row,
+                   n_r = n_x[u - ua] + n_row;
+      if (std::abs(n_r) > 1e-6) {
+        const double t = n_c / n_r;
+        const FacePoint q{t * a_r - a_c, t * b_r - b_c, 0.0};
         const double qa = std::abs(q.a), qb = std::abs(q.b);
-        if (qa <= f.half_a + margin && qb <= f.half_b + margin &&
-            (qa > f.half_a - margin || qb > f.half_b - margin)) {
-          grid->push_back(q);
-        }
+        if (qa <= lim_a && qb <= lim_b && (qa > in_a || qb > in_b)) grid->push_back(q);
       }
-      const float z = depth.at(u, v);
+      const float z = zrow[u];
       if (std::isnan(z)) continue;
-      const Eigen::Vector3d d = z * ray - f.c;
-      const FacePoint q{d.dot(f.a), d.dot(f.b), d.dot(f.n)};
-      if (std::abs(q.a) > f.half_a + margin || std::abs(q.b) > f.half_b + margin) continue;
+      const FacePoint q{z * a_r - a_c, z * b_r - b_c, z * n_r - n_c};
+      if (std::abs(q.a) > lim_a || std::abs(q.b) > lim_b) continue;
       if (q.n > plane_tol) {
         front->push_back(q);
         continue;
@@ -113,14 +123,34 @@ struct SideMeasure {
   bool measured() const { return kind == SideKind::kFree || kind == SideKind::kSeam; }
 };
 
-// Looks for the seam two touching boxes leave between coplanar faces. A
-// wide enough gap shows as a line of missing returns (a dip in the density
-// of points on the plane); a fine one only as a shallow groove from the
-// rounded edges (a dip in their mean height). Both are measured in a window
-// sliding across the side, against flanks a few pixels away, and only within
-// seam_search_m of the hypothesised side: the Kinect's depth noise is
-// spatially correlated, and a dip searched for everywhere is often noise.
-// Returns the seam's position (outward coordinate) or nothing.
+// Sorts values whose key lies in [lo, hi) (clamped) by bucketing on the key
+// and sorting each small bucket: the same order as std::sort in linear
+// time (the buckets are monotonic in the key).
+template <typename T, typename Key>
+void BucketSort(std::vector<T>* values, double lo, double hi, Key key) {
+  const size_t n = values->size();
+  if (n < 64) {
+    std::sort(values->begin(), values->end());
+    return;
+  }
+  const size_t buckets = n / 2;
+  const double scale = static_cast<double>(buckets) / (hi - lo);
+  auto bucket_of = [&](const T& x) {
+    const double b = (key(x) - lo) * scale;
+    return b <= 0.0 ? size_t{0} : std::min(buckets - 1, static_cast<size_t>(b));
+  };
+  std::vector<size_t> start(buckets + 1, 0);
+  for (const T& x : *values) ++start[bucket_of(x) + 1];
+  for (size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
+  std::vector<T> out(n);
+  std::vector<size_t> next(start.begin(), start.end() - 1);
+  for (const T& x : *values) out[next[bucket_of(x)]++] = x;
+  for (size_t b = 0; b < buckets; ++b) {
+    if (start[b + 1] - start[b] > 1) std::sort(out.begin() + start[b], out.begin() + start[b + 1]);
+  }
+  *values = std::move(out);
+}
+
 // The seam test over the points of one stretch of a side: strength(c) > 0
 // where a seam shows at offset c. Built once for the whole side, sorted;
 // a stretch (along in [along_lo, along_hi)) is a filtered copy, which keeps
@@ -145,8 +175,8 @@ class SeamScan {
       double across, along;
       if (band(p, &across, &along)) expected_.push_back({across, along});
     }
-    std::sort(expected_.begin(), expected_.end());
-    std::sort(rows.begin(), rows.end());
+    BucketSort(&expected_, -reach, reach, [](const auto& e) { return e.first; });
+    BucketSort(&rows, -reach, reach, [](const Row& r) { return r.across; });
     rows_ = std::move(rows);
     Index();
     w_ = std::max(0.003, 2.5 * pixel_m);  // centre window width
@@ -234,6 +264,14 @@ class SeamScan {
   double w_ = 0.0, f0_ = 0.0, f1_ = 0.0;
 };
 
+// Looks for the seam two touching boxes leave between coplanar faces. A
+// wide enough gap shows as a line of missing returns (a dip in the density
+// of points on the plane); a fine one only as a shallow groove from the
+// rounded edges (a dip in their mean height). Both are measured in a window
+// sliding across the side, against flanks a few pixels away, and only within
+// seam_search_m of the hypothesised side: the Kinect's depth noise is
+// spatially correlated, and a dip searched for everywhere is often noise.
+// Returns the seam's position (outward coordinate) or nothing.
 std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
                                const std::vector<FacePoint>& grid, bool along_a, double sign,
                                double half, double half_other, double pixel_m,

@@ -21,6 +21,7 @@ namespace cornerpose {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+constexpr int kMaxEdgeLattice = 4;
 double MsSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
@@ -274,6 +275,10 @@ absl::Status DetectorOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("size_tolerance_m=", *size_tolerance_m, " is outside (0, 0.1]"));
   }
+  if (!(edge_lattice_radius_px >= 0.0 && edge_lattice_radius_px <= 100.0)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "edge_lattice_radius_px=", edge_lattice_radius_px, " is outside [0, 100]"));
+  }
   if (max_declined < 0 || max_declined > 1000) {
     return absl::InvalidArgumentError(
         absl::StrCat("max_declined=", max_declined, " is outside [0, 1000]"));
@@ -347,6 +352,12 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
     DeriveGeometryParameters(MedianDepth(depth.z), camera.fx, &options);
   }
   if (options.size_tolerance_m) ApplySizeTolerance(*options.size_tolerance_m, &options);
+  if (options.edge_lattice_radius_px > 0.0) {
+    const double z = MedianDepth(depth.z);
+    const double radius_px = z > 0.0 ? options.edge_points.radius_m * camera.fx / z : 0.0;
+    options.edge_points.lattice_px = std::clamp(
+        static_cast<int>(radius_px / options.edge_lattice_radius_px), 1, kMaxEdgeLattice);
+  }
   det.timings.preprocess_ms = MsSince(t_start);
 
   Clock::time_point t0 = Clock::now();

@@ -90,6 +90,13 @@ struct DetectorOptions {
   // DeriveGeometryParameters); a value the caller changed is kept. False
   // keeps the defaults as they are.
   bool parameters_from_geometry = true;
+  // The resolution the edge stage works at (EdgePointOptions::lattice_px):
+  // every k-th pixel, k = floor(r_s fx / z / edge_lattice_radius_px) at the
+  // frame's median depth z, so r_s spans at least this many lattice steps;
+  // 1 when it spans fewer. The edge score of each pixel still reads its
+  // whole neighbourhood at full resolution, and the boxes are refined and
+  // judged on every pixel. 0 keeps edge_points.lattice_px as it is. Pixels.
+  double edge_lattice_radius_px = 5.0;
   // Declined hypotheses reported per frame (the strongest). Count, >= 0.
   int max_declined = 8;
   // Each confirmed box proposes the boxes that would touch it side by side

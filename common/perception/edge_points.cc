@@ -61,46 +61,46 @@ class OrganizedScorer {
         radius2_(static_cast<float>(options.radius_m * options.radius_m)),
         pattern_(UnitDiscPattern(std::max(options.max_samples, 1))) {
     BuildOffsets(options.max_samples, &offsets_);
-    BuildOffsets(options.coarse_samples > 0 ? options.coarse_samples : options.max_samples,
-                 &coarse_offsets_);
   }
 
   // The score of pixel (u, v), or -1 where it is not scored (no return,
-  // neighbourhood cut by the frame, too few neighbours); with `coarse`, from
-  // the coarse pass's fewer samples.
-  float ScoreAt(int u, int v, bool coarse = false) const {
+  // neighbourhood cut by the frame, too few neighbours).
+  float ScoreAt(int u, int v) const {
     const Eigen::Vector3f& p = cloud_.xyz[v * cloud_.width + u];
     if (!PointCloud::IsValid(p) || p.z() <= 0.0f) return -1.0f;
     const float radius_px = static_cast<float>(options_.radius_m) * focal_px_ / p.z();
     if (CutByBorder(u, v, radius_px)) return -1.0f;
-    const NeighbourSum n = Neighbours(u, v, p, radius_px, coarse ? coarse_offsets_ : offsets_);
+    const NeighbourSum n = Neighbours(u, v, p, radius_px);
     if (n.count < options_.min_neighbours) return -1.0f;
     return n.Score();
   }
 
-  // Coarse pass: the score of each grid cell's (step x step pixels) centre
-  // pixel, -1 where it is not scored.
-  void ScoreCoarse(int cell_row_begin, int cell_row_end, int step,
+  // Coarse pass: the score of each grid cell's (cell_px x cell_px pixels)
+  // centre pixel on the lattice of every `lattice` pixels, -1 where it is
+  // not scored.
+  void ScoreCoarse(int cell_row_begin, int cell_row_end, int cell_px, int lattice,
                    std::vector<float>* cell_scores) const {
-    const int cells_w = (cloud_.width + step - 1) / step;
+    const int cells_w = (cloud_.width + cell_px - 1) / cell_px;
+    const int centre = (cell_px / lattice / 2) * lattice;
     for (int cv = cell_row_begin; cv < cell_row_end; ++cv) {
       for (int cu = 0; cu < cells_w; ++cu) {
-        const int u = std::min(cu * step + step / 2, cloud_.width - 1);
-        const int v = std::min(cv * step + step / 2, cloud_.height - 1);
-        (*cell_scores)[cv * cells_w + cu] = ScoreAt(u, v, /*coarse=*/true);
+        const int u = std::min(cu * cell_px + centre, cloud_.width - 1);
+        const int v = std::min(cv * cell_px + centre, cloud_.height - 1);
+        (*cell_scores)[cv * cells_w + cu] = ScoreAt(u, v);
       }
     }
   }
 
-  // Full-resolution pass over rows; with `cells` (1: score the cell's
-  // pixels), only those pixels are scored.
-  void ScoreRows(int row_begin, int row_end, int step, const std::vector<uint8_t>* cells,
-                 Chunk* out) const {
+  // Full-resolution pass over the rows [row_begin, row_end) of the lattice
+  // of every `lattice` pixels; with `cells` (1: score the cell's pixels,
+  // cells of cell_px), only those pixels are scored.
+  void ScoreRows(int row_begin, int row_end, int lattice, int cell_px,
+                 const std::vector<uint8_t>* cells, Chunk* out) const {
     const int w = cloud_.width;
-    const int cells_w = (w + step - 1) / step;
-    for (int v = row_begin; v < row_end; ++v) {
-      for (int u = 0; u < w; ++u) {
-        if (cells != nullptr && !(*cells)[(v / step) * cells_w + u / step]) continue;
+    const int cells_w = (w + cell_px - 1) / cell_px;
+    for (int v = (row_begin + lattice - 1) / lattice * lattice; v < row_end; v += lattice) {
+      for (int u = 0; u < w; u += lattice) {
+        if (cells != nullptr && !(*cells)[(v / cell_px) * cells_w + u / cell_px]) continue;
         const float score = ScoreAt(u, v);
         if (score <= options_.threshold) continue;
         const Eigen::Vector3f& p = cloud_.xyz[v * w + u];
@@ -157,8 +157,7 @@ class OrganizedScorer {
   // On a Kinect the point's own axial noise (2-4 mm) tilts every d_j the same
   // way and lifts a flat patch's score to ~0.2-0.4, so one in ten floor
   // points would pass t_h; the median offset is ~0 at a true edge.
-  NeighbourSum Neighbours(int u, int v, const Eigen::Vector3f& p, float radius_px,
-                          const OffsetTables& tables) const {
+  NeighbourSum Neighbours(int u, int v, const Eigen::Vector3f& p, float radius_px) const {
     // The neighbours as structure of arrays (per thread, sized once): the
     // unit vectors are then taken four at a time.
     thread_local std::vector<float> fx, fy, fz, dz;
@@ -168,7 +167,7 @@ class OrganizedScorer {
     // Clamped before the cast: r fx / z is unbounded for a point near z = 0.
     const float quarter_px = radius_px * 4.0f + 0.5f;
     const int bucket = quarter_px < kMaxBucket ? static_cast<int>(quarter_px) : kMaxBucket;
-    const std::vector<int>& offsets = tables[bucket];
+    const std::vector<int>& offsets = offsets_[bucket];
     // Room for a whole block of four past the last neighbour.
     if (fx.size() < offsets.size() + 4) {
       for (std::vector<float>* a : {&fx, &fy, &fz, &dz}) a->resize(offsets.size() + 4);
@@ -266,7 +265,7 @@ class OrganizedScorer {
   const std::vector<Eigen::Vector2f> pattern_;
   // Radii above kMaxBucket / 4 pixels (points nearer than ~0.17 m for the
   // default radius and a VGA camera) use the largest table.
-  OffsetTables offsets_, coarse_offsets_;
+  OffsetTables offsets_;
 };
 
 EdgePoints Merge(const PointCloud& cloud, std::vector<Chunk>& chunks) {
@@ -285,20 +284,25 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
   const OrganizedScorer scorer(cloud, options, focal_px);
   std::vector<Chunk> chunks(options.num_threads);
   const int step = options.coarse_step;
+  const int lattice = options.lattice_px;
   if (step <= 1) {
     internal::ParallelForRanges(cloud.height, options.num_threads, [&](int t, int begin, int end) {
-      scorer.ScoreRows(begin, end, 1, nullptr, &chunks[t]);
+      scorer.ScoreRows(begin, end, lattice, 1, nullptr, &chunks[t]);
     });
     return Merge(cloud, chunks);
   }
   // Coarse to fine: edge bands are several pixels wide, so a grid of one
-  // pixel in step x step finds every band; the pixels of the hit cells and
-  // of the cells next to them that may hold a band's rim are then scored at
-  // full resolution, with the real threshold.
-  const int cells_w = (cloud.width + step - 1) / step, cells_h = (cloud.height + step - 1) / step;
+  // pixel in step x step (of the lattice) finds every band; the pixels of
+  // the hit cells and of the cells next to them that may hold a band's rim
+  // are then scored at full resolution, with the real threshold.
+  // The cells stay about coarse_step pixels wide on a coarser lattice: a
+  // band narrower than a cell can be missed.
+  const int cell_px = std::max(1, (step + lattice - 1) / lattice) * lattice;
+  const int cells_w = (cloud.width + cell_px - 1) / cell_px,
+            cells_h = (cloud.height + cell_px - 1) / cell_px;
   std::vector<float> cell_scores(static_cast<size_t>(cells_w) * cells_h, -1.0f);
   internal::ParallelForRanges(cells_h, options.num_threads, [&](int, int begin, int end) {
-    scorer.ScoreCoarse(begin, end, step, &cell_scores);
+    scorer.ScoreCoarse(begin, end, cell_px, lattice, &cell_scores);
   });
   const float hit = static_cast<float>(options.threshold * options.coarse_threshold_factor);
   const float rim = static_cast<float>(options.threshold * options.coarse_skip_factor);
@@ -320,7 +324,7 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
     }
   }
   internal::ParallelForRanges(cloud.height, options.num_threads, [&](int t, int begin, int end) {
-    scorer.ScoreRows(begin, end, step, &cells, &chunks[t]);
+    scorer.ScoreRows(begin, end, lattice, cell_px, &cells, &chunks[t]);
   });
   return Merge(cloud, chunks);
 }
@@ -439,9 +443,9 @@ absl::Status EdgePointOptions::Validate() const {
     return absl::InvalidArgumentError(absl::StrCat(
         "edge coarse_threshold_factor=", coarse_threshold_factor, " is outside (0, 1]"));
   }
-  if (coarse_samples < 0 || coarse_samples > 4096) {
+  if (lattice_px < 1 || lattice_px > 8) {
     return absl::InvalidArgumentError(
-        absl::StrCat("edge coarse_samples=", coarse_samples, " is outside [0, 4096]"));
+        absl::StrCat("edge lattice_px=", lattice_px, " is outside [1, 8]"));
   }
   if (!(coarse_skip_factor >= 0.0 && coarse_skip_factor <= 1.0)) {
     return absl::InvalidArgumentError(

@@ -258,10 +258,12 @@ INSTANTIATE_TEST_SUITE_P(Views, EdgePointsOnRenderedBoxTest,
                          ::testing::Values(ViewParam{0.0, 0.0, 0.0}, ViewParam{0.0, 0.0, 30.0},
                                            ViewParam{25.0, 40.0, -20.0}));
 
-// The cells next to a coarse hit whose own centre scores low are not scored
-// (EdgePointOptions::coarse_skip_factor): on clutter of every kind and both
-// sensor models that loses almost none of the edge points scoring all of
-// them finds (only ever loses: the scores themselves do not change).
+// The cells next to a coarse hit whose own centre scores low can be left
+// unscored (EdgePointOptions::coarse_skip_factor, off by default): on clutter
+// of every kind and both sensor models that loses under 1 % of the edge
+// points (only ever loses: the scores themselves do not change). Off by
+// default all the same: on the stereo sets that 1 % changed which boxes were
+// found (scripts/evaluate, README "Speed").
 TEST(EdgePointsTest, SkippingLowCellsNextToHitsKeepsTheEdgePoints) {
   size_t all = 0, lost = 0;
   for (const SensorKind sensor_kind : {SensorKind::kKinect, SensorKind::kStereo}) {
@@ -277,11 +279,11 @@ TEST(EdgePointsTest, SkippingLowCellsNextToHitsKeepsTheEdgePoints) {
         const RenderedScene out = Render(*scene, sensor);
         EdgePointOptions every_cell;
         every_cell.coarse_skip_factor = 0.0;
-        every_cell.coarse_samples = 0;
         const absl::StatusOr<EdgePoints> a =
             DetectEdgePoints(out.cloud, every_cell, out.camera.fx);
-        const absl::StatusOr<EdgePoints> b =
-            DetectEdgePoints(out.cloud, EdgePointOptions{}, out.camera.fx);
+        EdgePointOptions skipping;
+        skipping.coarse_skip_factor = 0.5;
+        const absl::StatusOr<EdgePoints> b = DetectEdgePoints(out.cloud, skipping, out.camera.fx);
         ASSERT_TRUE(a.ok() && b.ok());
         const std::unordered_set<int> in_b(b->indices.begin(), b->indices.end());
         size_t lost_here = 0;
@@ -296,7 +298,7 @@ TEST(EdgePointsTest, SkippingLowCellsNextToHitsKeepsTheEdgePoints) {
   std::cout << "skipping low cells: " << lost << " of " << all << " edge points lost ("
             << 100.0 * share << " %)\n";
   ASSERT_GT(all, 10000u);
-  EXPECT_LE(share, 0.005);
+  EXPECT_LE(share, 0.01);
 }
 
 TEST(EdgePointsTest, CoarsePassKeepsNearlyAllFullResolutionEdges) {

@@ -185,12 +185,12 @@ double Quantile(std::vector<double> v, double q) {
 void BM_ClutterSet(benchmark::State& state) {
   const std::vector<Frame>& frames = ClutterSet();
   std::vector<double> total, edges, segments, poses;
-  int correct = 0, pickable = 0, returned = 0;
+  int correct = 0, pickable = 0, returned = 0, proposed = 0, refined = 0, accepted = 0;
   // A digest of what was found (poses, scores, edge points, segments): equal
   // digests across builds mean the same detections.
   double digest = 0.0;
   for (auto _ : state) {
-    correct = pickable = returned = 0;
+    correct = pickable = returned = proposed = refined = accepted = 0;
     digest = 0.0;
     for (const Frame& f : frames) {
       DetectorOptions o;
@@ -206,6 +206,9 @@ void BM_ClutterSet(benchmark::State& state) {
       segments.push_back(d->timings.edge_segments_ms);
       poses.push_back(d->timings.poses_ms);
       correct += CorrectBoxes(*d, f.truth);
+      proposed += d->hypotheses.proposed;
+      refined += d->hypotheses.refined;
+      accepted += d->hypotheses.accepted;
       returned += static_cast<int>(d->boxes.size());
       for (const DetectedBox& b : d->boxes) {
         const Eigen::Vector3d t = b.camera_T_box.translation();
@@ -225,6 +228,9 @@ void BM_ClutterSet(benchmark::State& state) {
   state.counters["returned"] = returned;
   state.counters["pickable"] = pickable;
   state.counters["digest"] = digest;
+  state.counters["proposed"] = proposed;
+  state.counters["refined"] = refined;
+  state.counters["accepted"] = accepted;
 }
 // Arg: threads.
 BENCHMARK(BM_ClutterSet)
