@@ -17,6 +17,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/perception/internal/parallel.h"
+#include "common/perception/internal/select_kth.h"
 
 namespace cornerpose {
 namespace {
@@ -61,6 +62,16 @@ class OrganizedScorer {
         radius2_(static_cast<float>(options.radius_m * options.radius_m)),
         pattern_(UnitDiscPattern(std::max(options.max_samples, 1))) {
     BuildOffsets(options.max_samples, &offsets_);
+    // The points as three planes: a neighbour's coordinates are then three
+    // loads at one offset, and the loops over them vectorize.
+    xs_.resize(cloud.size());
+    ys_.resize(cloud.size());
+    zs_.resize(cloud.size());
+    for (size_t i = 0; i < cloud.size(); ++i) {
+      xs_[i] = cloud.xyz[i].x();
+      ys_[i] = cloud.xyz[i].y();
+      zs_[i] = cloud.xyz[i].z();
+    }
   }
 
   // The score of pixel (u, v), or -1 where it is not scored (no return,
@@ -158,12 +169,14 @@ class OrganizedScorer {
   // way and lifts a flat patch's score to ~0.2-0.4, so one in ten floor
   // points would pass t_h; the median offset is ~0 at a true edge.
   NeighbourSum Neighbours(int u, int v, const Eigen::Vector3f& p, float radius_px) const {
-    // The neighbours as structure of arrays (per thread, sized once): the
-    // unit vectors are then taken four at a time.
+    // The neighbours as structure of arrays (per thread, sized once).
     thread_local std::vector<float> fx, fy, fz, dz;
     const float reach2 = 2.25f * radius2_;  // 1.5 r_s: room for p's own noise
     // CutByBorder() has kept the whole disc inside the image.
-    const Eigen::Vector3f* base = &cloud_.xyz[static_cast<size_t>(v) * cloud_.width + u];
+    const size_t at = static_cast<size_t>(v) * cloud_.width + u;
+    const float* xs = xs_.data() + at;
+    const float* ys = ys_.data() + at;
+    const float* zs = zs_.data() + at;
     // Clamped before the cast: r fx / z is unbounded for a point near z = 0.
     const float quarter_px = radius_px * 4.0f + 0.5f;
     const int bucket = quarter_px < kMaxBucket ? static_cast<int>(quarter_px) : kMaxBucket;
@@ -172,64 +185,60 @@ class OrganizedScorer {
     if (fx.size() < offsets.size() + 4) {
       for (std::vector<float>* a : {&fx, &fy, &fz, &dz}) a->resize(offsets.size() + 4);
     }
+    // Without branches: every neighbour is written, and kept (m advances)
+    // when it is within reach; a no-return (NaN) compares false.
+    const float px = p.x(), py = p.y(), pz = p.z();
     size_t m = 0;
     for (const int off : offsets) {
-      const Eigen::Vector3f& q = base[off];
-      if (!(q.z() == q.z())) continue;  // NaN: no return
-      if ((q - p).squaredNorm() <= reach2) {
-        fx[m] = q.x();
-        fy[m] = q.y();
-        fz[m] = q.z();
-        ++m;
-      }
+      const float x = xs[off], y = ys[off], z = zs[off];
+      const float dx = x - px, dy = y - py, dzp = z - pz;
+      fx[m] = x;
+      fy[m] = y;
+      fz[m] = z;
+      m += (dx * dx + dy * dy) + dzp * dzp <= reach2;
     }
     Eigen::Vector3f centre = p;
     if (options_.denoise && m >= 3) {
-      for (size_t k = 0; k < m; ++k) dz[k] = fz[k] - p.z();
-      std::nth_element(dz.begin(), dz.begin() + m / 2, dz.begin() + m);
-      centre = p * ((p.z() + dz[m / 2]) / p.z());
+      for (size_t k = 0; k < m; ++k) dz[k] = fz[k] - pz;
+      const float median =
+          internal::SelectKth(dz.data(), static_cast<int>(m), static_cast<int>(m / 2));
+      centre = p * ((pz + median) / pz);
     }
     return UnitVectorSum(fx.data(), fy.data(), fz.data(), m, centre);
   }
 
-  // The sum of the unit vectors from `centre` to the neighbours within r_s,
-  // in the neighbours' order. Each lane of the SSE path does the scalar
-  // path's operations in the same order (IEEE sqrt and division are exact to
-  // the bit), so both give the same score.
-  NeighbourSum UnitVectorSum(float* x, float* y, float* z, size_t m,
+  // The sum of the unit vectors from `centre` to the neighbours within r_s
+  // (SSE: four neighbours at a time, summed in four lanes).
+  NeighbourSum UnitVectorSum(const float* x, const float* y, const float* z, size_t m,
                              const Eigen::Vector3f& centre) const {
+    NeighbourSum n;
     size_t k = 0;
 #if defined(__SSE2__)
-    // x, y, z become the unit vector (or 0 where the neighbour is out of reach).
     const __m128 cx = _mm_set1_ps(centre.x()), cy = _mm_set1_ps(centre.y()),
                  cz = _mm_set1_ps(centre.z()), r2 = _mm_set1_ps(radius2_),
                  zero = _mm_setzero_ps();
-    thread_local std::vector<uint8_t> within;
-    if (within.size() < m + 4) within.resize(m + 4);
+    __m128 sx = zero, sy = zero, sz = zero;
+    int count = 0;
     for (; k + 4 <= m; k += 4) {
       const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x + k), cx);
       const __m128 dy = _mm_sub_ps(_mm_loadu_ps(y + k), cy);
       const __m128 dzv = _mm_sub_ps(_mm_loadu_ps(z + k), cz);
       const __m128 d2 =
           _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dzv, dzv));
-      const int mask =
-          _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(d2, r2), _mm_cmpgt_ps(d2, zero)));
-      const __m128 len = _mm_sqrt_ps(d2);
-      _mm_storeu_ps(x + k, _mm_div_ps(dx, len));
-      _mm_storeu_ps(y + k, _mm_div_ps(dy, len));
-      _mm_storeu_ps(z + k, _mm_div_ps(dzv, len));
-      for (int l = 0; l < 4; ++l) within[k + l] = (mask >> l) & 1;
+      const __m128 within = _mm_and_ps(_mm_cmple_ps(d2, r2), _mm_cmpgt_ps(d2, zero));
+      const __m128 inv = _mm_and_ps(within, _mm_div_ps(_mm_set1_ps(1.0f), _mm_sqrt_ps(d2)));
+      sx = _mm_add_ps(sx, _mm_mul_ps(dx, inv));
+      sy = _mm_add_ps(sy, _mm_mul_ps(dy, inv));
+      sz = _mm_add_ps(sz, _mm_mul_ps(dzv, inv));
+      count += __builtin_popcount(static_cast<unsigned>(_mm_movemask_ps(within)));
     }
-    NeighbourSum n;
-    for (size_t j = 0; j < k; ++j) {
-      if (!within[j]) continue;
-      n.sum.x() += x[j];
-      n.sum.y() += y[j];
-      n.sum.z() += z[j];
-      ++n.count;
-    }
-#else
-    NeighbourSum n;
+    alignas(16) float lx[4], ly[4], lz[4];
+    _mm_store_ps(lx, sx);
+    _mm_store_ps(ly, sy);
+    _mm_store_ps(lz, sz);
+    n.sum = Eigen::Vector3f((lx[0] + lx[1]) + (lx[2] + lx[3]), (ly[0] + ly[1]) + (ly[2] + ly[3]),
+                            (lz[0] + lz[1]) + (lz[2] + lz[3]));
+    n.count = count;
 #endif
     for (; k < m; ++k) {
       const Eigen::Vector3f d = Eigen::Vector3f(x[k], y[k], z[k]) - centre;
@@ -266,6 +275,7 @@ class OrganizedScorer {
   // Radii above kMaxBucket / 4 pixels (points nearer than ~0.17 m for the
   // default radius and a VGA camera) use the largest table.
   OffsetTables offsets_;
+  std::vector<float> xs_, ys_, zs_;
 };
 
 EdgePoints Merge(const PointCloud& cloud, std::vector<Chunk>& chunks) {
@@ -282,13 +292,17 @@ EdgePoints Merge(const PointCloud& cloud, std::vector<Chunk>& chunks) {
 EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& options,
                            double focal_px) {
   const OrganizedScorer scorer(cloud, options, focal_px);
-  std::vector<Chunk> chunks(options.num_threads);
+  // Blocks of rows, taken by the threads as they finish one (edge bands
+  // gather in some rows), each with its own output, merged in row order.
+  constexpr int kRowsPerBlock = 8;
+  std::vector<Chunk> chunks((cloud.height + kRowsPerBlock - 1) / kRowsPerBlock);
   const int step = options.coarse_step;
   const int lattice = options.lattice_px;
   if (step <= 1) {
-    internal::ParallelForRanges(cloud.height, options.num_threads, [&](int t, int begin, int end) {
-      scorer.ScoreRows(begin, end, lattice, 1, nullptr, &chunks[t]);
-    });
+    internal::ParallelForChunks(cloud.height, kRowsPerBlock, options.num_threads,
+                                [&](int c, int begin, int end) {
+                                  scorer.ScoreRows(begin, end, lattice, 1, nullptr, &chunks[c]);
+                                });
     return Merge(cloud, chunks);
   }
   // Coarse to fine: edge bands are several pixels wide, so a grid of one
@@ -301,7 +315,7 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
   const int cells_w = (cloud.width + cell_px - 1) / cell_px,
             cells_h = (cloud.height + cell_px - 1) / cell_px;
   std::vector<float> cell_scores(static_cast<size_t>(cells_w) * cells_h, -1.0f);
-  internal::ParallelForRanges(cells_h, options.num_threads, [&](int, int begin, int end) {
+  internal::ParallelForChunks(cells_h, 4, options.num_threads, [&](int, int begin, int end) {
     scorer.ScoreCoarse(begin, end, cell_px, lattice, &cell_scores);
   });
   const float hit = static_cast<float>(options.threshold * options.coarse_threshold_factor);
@@ -323,9 +337,10 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
       cells[cv * cells_w + cu] = near_hit;
     }
   }
-  internal::ParallelForRanges(cloud.height, options.num_threads, [&](int t, int begin, int end) {
-    scorer.ScoreRows(begin, end, lattice, cell_px, &cells, &chunks[t]);
-  });
+  internal::ParallelForChunks(cloud.height, kRowsPerBlock, options.num_threads,
+                              [&](int c, int begin, int end) {
+                                scorer.ScoreRows(begin, end, lattice, cell_px, &cells, &chunks[c]);
+                              });
   return Merge(cloud, chunks);
 }
 

@@ -1,4 +1,5 @@
 #include "common/perception/edge_points.h"
+#include "common/perception/internal/select_kth.h"
 
 #include <gtest/gtest.h>
 
@@ -299,6 +300,28 @@ TEST(EdgePointsTest, SkippingLowCellsNextToHitsKeepsTheEdgePoints) {
             << 100.0 * share << " %)\n";
   ASSERT_GT(all, 10000u);
   EXPECT_LE(share, 0.01);
+}
+
+// SelectKth gives what std::nth_element puts at k, on every size the edge
+// score sees, with ties (quantized depths) and with values all alike.
+TEST(SelectKthTest, MatchesNthElement) {
+  std::mt19937 rng(3);
+  for (int n = 1; n <= 130; ++n) {
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<float> a(n);
+      const int levels = trial % 3 == 0 ? 1 : trial % 3 == 1 ? 4 : 1000;
+      std::uniform_int_distribution<int> level(0, levels - 1);
+      for (float& x : a) x = 0.001f * static_cast<float>(level(rng)) - 0.2f;
+      for (const int k : {0, n / 2, n - 1}) {
+        std::vector<float> b = a, c = a;
+        std::nth_element(b.begin(), b.begin() + k, b.end());
+        ASSERT_EQ(internal::SelectKth(c.data(), n, k), b[k]) << "n " << n << " k " << k;
+        std::sort(c.begin(), c.end());
+        std::sort(b.begin(), b.end());
+        ASSERT_EQ(b, c);  // a permutation of the input
+      }
+    }
+  }
 }
 
 TEST(EdgePointsTest, CoarsePassKeepsNearlyAllFullResolutionEdges) {

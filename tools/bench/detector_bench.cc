@@ -235,6 +235,7 @@ void BM_ClutterSet(benchmark::State& state) {
 // Arg: threads.
 BENCHMARK(BM_ClutterSet)
     ->ArgNames({"threads"})
+    ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
