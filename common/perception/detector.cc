@@ -315,6 +315,7 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   }
   DetectorOptions options = options_in;
   options.edge_points.num_threads = options.num_threads;
+  options.segments.num_threads = options.num_threads;
   Detection det;
 
   // Preprocess: the camera and its depth image.

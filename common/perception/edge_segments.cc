@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "absl/strings/str_cat.h"
+#include "common/perception/internal/parallel.h"
 
 namespace cornerpose {
 namespace {
@@ -81,7 +82,8 @@ class SegmentFitter {
         alive_(pts.size(), 1),
         num_alive_(static_cast<int>(pts.size())),
         grid_(pts, static_cast<float>(o.sample_max_m / 2.0)),
-        rng_(o.seed) {}
+        rng_(o.seed),
+        pool_(o.num_threads) {}
 
   std::vector<EdgeSegment> Run() {
     std::vector<EdgeSegment> segments;
@@ -116,13 +118,18 @@ class SegmentFitter {
     if (alive.size() < 2) return std::nullopt;
     std::vector<int> subset = alive;
     if (static_cast<int>(subset.size()) > options_.ransac_subset) {
-      std::shuffle(subset.begin(), subset.end(), rng_);
+      // A uniform random subset: the first ransac_subset of a partial
+      // Fisher-Yates shuffle.
+      for (int i = 0; i < options_.ransac_subset; ++i) {
+        const int j = std::uniform_int_distribution<int>(
+            i, static_cast<int>(subset.size()) - 1)(rng_);
+        std::swap(subset[i], subset[j]);
+      }
       subset.resize(options_.ransac_subset);
     }
     const float t2 = static_cast<float>(options_.ransac_threshold_m * options_.ransac_threshold_m);
     const float min2 = static_cast<float>(options_.sample_min_m * options_.sample_min_m);
     const float max2 = static_cast<float>(options_.sample_max_m * options_.sample_max_m);
-    std::uniform_int_distribution<int> pick(0, static_cast<int>(alive.size()) - 1);
     // The subset as structure of arrays: the count below is the stage's
     // inner loop (iterations x subset), and in this layout it vectorizes.
     sx_.resize(subset.size());
@@ -133,27 +140,44 @@ class SegmentFitter {
       sy_[k] = pts_[subset[k]].y();
       sz_[k] = pts_[subset[k]].z();
     }
+    // The random draws first, in order (two per iteration: the first point,
+    // and where among its candidates the second lies), so the iterations can
+    // run on any thread and the result does not depend on which.
+    const int iterations = options_.ransac_iterations;
+    std::vector<int> first(iterations);
+    std::vector<float> second(iterations);
+    std::uniform_int_distribution<int> pick(0, static_cast<int>(alive.size()) - 1);
+    std::uniform_real_distribution<float> where(0.0f, 1.0f);
+    for (int it = 0; it < iterations; ++it) {
+      first[it] = alive[pick(rng_)];
+      second[it] = where(rng_);
+    }
+    std::vector<int> counts(iterations, -1);
+    std::vector<Line> lines(iterations);
+    pool_.Run(iterations, [&](int, int begin, int end) {
+      std::vector<int> candidates;
+      for (int it = begin; it < end; ++it) {
+        const int a = first[it];
+        candidates.clear();
+        grid_.ForNear(pts_[a], [&](int i) {
+          if (!alive_[i]) return;
+          const float d2 = (pts_[i] - pts_[a]).squaredNorm();
+          if (d2 >= min2 && d2 <= max2) candidates.push_back(i);
+        });
+        if (candidates.empty()) continue;
+        const size_t k = std::min(candidates.size() - 1,
+                                  static_cast<size_t>(second[it] * candidates.size()));
+        lines[it].point = pts_[a];
+        lines[it].direction = (pts_[candidates[k]] - pts_[a]).normalized();
+        counts[it] = CountWithin(lines[it], t2);
+      }
+    });
     std::optional<Line> best;
     int best_count = 0;
-    std::vector<int> candidates;
-    for (int it = 0; it < options_.ransac_iterations; ++it) {
-      const int a = alive[pick(rng_)];
-      candidates.clear();
-      grid_.ForNear(pts_[a], [&](int i) {
-        if (!alive_[i]) return;
-        const float d2 = (pts_[i] - pts_[a]).squaredNorm();
-        if (d2 >= min2 && d2 <= max2) candidates.push_back(i);
-      });
-      if (candidates.empty()) continue;
-      const int b =
-          candidates[std::uniform_int_distribution<size_t>(0, candidates.size() - 1)(rng_)];
-      Line line;
-      line.point = pts_[a];
-      line.direction = (pts_[b] - pts_[a]).normalized();
-      const int count = CountWithin(line, t2);
-      if (count > best_count) {
-        best_count = count;
-        best = line;
+    for (int it = 0; it < iterations; ++it) {
+      if (counts[it] > best_count) {
+        best_count = counts[it];
+        best = lines[it];
       }
     }
     return best;
@@ -284,6 +308,7 @@ class SegmentFitter {
   Grid grid_;
   std::mt19937 rng_;
   std::vector<float> sx_, sy_, sz_;  // the current RANSAC subset
+  internal::ForkJoin pool_;
 };
 
 }  // namespace
@@ -305,7 +330,8 @@ absl::Status EdgeSegmentOptions::Validate() const {
         range("min_points", min_points, 2, 1000000), range("min_length_m", min_length_m, 0.0, 10.0),
         range("removal_scale", removal_scale, 1.0, 10.0),
         range("max_segments", max_segments, 1, 100000),
-        range("max_failures", max_failures, 1, 100000)}) {
+        range("max_failures", max_failures, 1, 100000),
+        range("num_threads", num_threads, 1, 256)}) {
     if (!s.ok()) return s;
   }
   return absl::OkStatus();

@@ -41,6 +41,9 @@ struct EdgeSegmentOptions {
   int max_failures = 40;
   // Seed of the random generator: the same input and seed give the same output.
   uint32_t seed = 42;
+  // Threads for the RANSAC iterations (the result does not depend on it).
+  // Count, [1, 256].
+  int num_threads = 1;
 
   absl::Status Validate() const;
 };

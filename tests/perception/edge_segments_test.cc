@@ -224,6 +224,28 @@ TEST(FitEdgeSegmentsTest, SameSeedSameSegments) {
   }
 }
 
+// The RANSAC iterations run on several threads (internal::ForkJoin); what
+// they find must not depend on how many.
+TEST(FitEdgeSegmentsTest, SameSegmentsOnAnyNumberOfThreads) {
+  std::vector<Eigen::Vector3f> pts = RectangleOutline(TiltedRectangle(), 6);
+  const std::vector<Eigen::Vector3f> more = RectangleOutline(TiltedRectangle(), 4);
+  for (const Eigen::Vector3f& p : more) pts.push_back(p + Eigen::Vector3f(0.5f, 0.1f, 0.05f));
+  EdgeSegmentOptions one;
+  one.num_threads = 1;
+  EdgeSegmentOptions three;
+  three.num_threads = 3;
+  const auto a = FitEdgeSegments(pts, one);
+  const auto b = FitEdgeSegments(pts, three);
+  ASSERT_TRUE(a.ok() && b.ok());
+  ASSERT_GE(a->size(), 8u);
+  ASSERT_EQ(a->size(), b->size());
+  for (size_t i = 0; i < a->size(); ++i) {
+    EXPECT_EQ((*a)[i].end1, (*b)[i].end1);
+    EXPECT_EQ((*a)[i].end2, (*b)[i].end2);
+    EXPECT_EQ((*a)[i].num_points, (*b)[i].num_points);
+  }
+}
+
 TEST(FitEdgeSegmentsTest, EmptyAndSparseInputGiveNoSegments) {
   const auto none = FitEdgeSegments({}, EdgeSegmentOptions{});
   ASSERT_TRUE(none.ok()) << none.status();

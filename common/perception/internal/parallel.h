@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <functional>
 #include <thread>
 #include <vector>
 
@@ -50,5 +51,69 @@ void ParallelForChunks(int n, int chunk_size, int threads, Fn&& fn) {
   worker();
   for (std::thread& w : workers) w.join();
 }
+
+// Threads kept for many short fork-joins (a loop that runs a few dozen times
+// per frame, each run tens of microseconds: too short to start threads for,
+// or to wake a sleeping one, which takes as long on a VM). Run(n, fn) calls
+// fn(thread_index, begin, end) on `threads` contiguous chunks of [0, n),
+// chunk 0 on the caller's thread, and returns when all are done. Between
+// runs the helpers spin (yielding) rather than sleep: keep one only for the
+// stretch of work that uses it.
+class ForkJoin {
+ public:
+  explicit ForkJoin(int threads) {
+    for (int t = 1; t < threads; ++t) helpers_.emplace_back([this, t] { Serve(t); });
+  }
+  ~ForkJoin() {
+    stop_.store(true, std::memory_order_release);
+    for (std::thread& h : helpers_) h.join();
+  }
+  ForkJoin(const ForkJoin&) = delete;
+  ForkJoin& operator=(const ForkJoin&) = delete;
+
+  int threads() const { return static_cast<int>(helpers_.size()) + 1; }
+
+  template <typename Fn>
+  void Run(int n, Fn&& fn) {
+    const int threads = this->threads();
+    if (threads == 1 || n < 2) {
+      fn(0, 0, n);
+      return;
+    }
+    const std::function<void(int, int, int)> f = std::ref(fn);
+    fn_ = &f;
+    n_ = n;
+    pending_.store(threads - 1, std::memory_order_relaxed);
+    generation_.fetch_add(1, std::memory_order_release);
+    fn(0, 0, Bound(n, 1, threads));
+    while (pending_.load(std::memory_order_acquire) != 0) std::this_thread::yield();
+  }
+
+ private:
+  static int Bound(int n, int t, int threads) {
+    return static_cast<int>(static_cast<long long>(n) * t / threads);
+  }
+  void Serve(int t) {
+    long long seen = 0;
+    while (!stop_.load(std::memory_order_acquire)) {
+      const long long g = generation_.load(std::memory_order_acquire);
+      if (g == seen) {
+        std::this_thread::yield();
+        continue;
+      }
+      seen = g;
+      const int threads = this->threads();
+      (*fn_)(t, Bound(n_, t, threads), Bound(n_, t + 1, threads));
+      pending_.fetch_sub(1, std::memory_order_acq_rel);
+    }
+  }
+
+  std::vector<std::thread> helpers_;
+  const std::function<void(int, int, int)>* fn_ = nullptr;
+  int n_ = 0;
+  std::atomic<int> pending_{0};
+  std::atomic<long long> generation_{0};
+  std::atomic<bool> stop_{false};
+};
 
 }  // namespace cornerpose::internal
