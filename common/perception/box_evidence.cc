@@ -103,31 +103,64 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
     }
     return false;
   };
+  // The faces the camera sees, each a convex quad in the image: a pixel's
+  // ray enters the box through the face whose quad holds the pixel (what
+  // the slab cast gives, without casting every pixel), at the depth where
+  // it meets the face's plane.
+  struct VisibleFace {
+    int index;
+    Eigen::Vector3d normal;  // outward, camera frame
+    double plane;            // normal . x on the face
+    std::array<Eigen::Vector2d, 4> quad;
+  };
+  std::vector<VisibleFace> faces;
+  const Eigen::Matrix3d& R = camera_T_box.linear();
+  for (int fi = 0; fi < 6; ++fi) {
+    const int n = fi / 2, a = (n + 1) % 3, b = (n + 2) % 3;
+    const Eigen::Vector3d normal = (fi % 2 == 0 ? 1.0 : -1.0) * R.col(n);
+    const Eigen::Vector3d centre = camera_T_box.translation() + normal * half[n];
+    if (normal.dot(centre) >= 0.0) continue;  // seen from behind, or edge-on
+    VisibleFace f{fi, normal, normal.dot(centre), {}};
+    const double sa[4] = {-1.0, 1.0, 1.0, -1.0}, sb[4] = {-1.0, -1.0, 1.0, 1.0};
+    for (int c = 0; c < 4; ++c) {
+      f.quad[c] = Project(k, centre + sa[c] * half[a] * R.col(a) + sb[c] * half[b] * R.col(b));
+    }
+    faces.push_back(f);
+  }
   std::array<int, 6> face_px{};
   for (int v = va; v <= vb; v += step) {
-    for (int u = ua; u <= ub; u += step) {
-      double z_model;
-      int face;
-      if (!cast_ray(Eigen::Vector3d(ray_x[u - ua], ray_y[v - va], 1.0), &z_model, &face)) continue;
-      FaceEvidence& f = ev.faces[face];
-      ++face_px[face];
-      const float z = depth.at(u, v);
-      const double tol =
-          options.depth_tolerance_base_m + options.depth_tolerance_per_m2 * z_model * z_model;
-      const bool disagrees = std::isnan(z) || z > z_model + tol;
-      if (disagrees && near_outline(u, v)) {
-        ++f.border;
-        continue;
-      }
-      ++f.expected;
-      if (std::isnan(z)) {
-        ++f.missing;
-      } else if (z < z_model - tol) {
-        ++f.occluded;
-      } else if (z > z_model + tol) {
-        ++f.see_through;
-      } else {
-        ++f.agree;
+    const double ray_yv = ray_y[v - va];
+    for (const VisibleFace& face : faces) {
+      // The quad's span on this row, [x0, x1): neighbouring faces share an
+      // end, so no pixel counts twice.
+      double x0, x1;
+      if (!QuadRowSpan(face.quad, v, &x0, &x1)) continue;
+      const int first = ua + std::max(0, static_cast<int>(std::ceil((x0 - ua) / step))) * step;
+      for (int u = first; u <= ub && u < x1; u += step) {
+        const double facing =
+            face.normal.x() * ray_x[u - ua] + face.normal.y() * ray_yv + face.normal.z();
+        if (!(facing < 0.0)) continue;
+        const double z_model = face.plane / facing;  // rays have unit z
+        FaceEvidence& f = ev.faces[face.index];
+        ++face_px[face.index];
+        const float z = depth.at(u, v);
+        const double tol =
+            options.depth_tolerance_base_m + options.depth_tolerance_per_m2 * z_model * z_model;
+        const bool disagrees = std::isnan(z) || z > z_model + tol;
+        if (disagrees && near_outline(u, v)) {
+          ++f.border;
+          continue;
+        }
+        ++f.expected;
+        if (std::isnan(z)) {
+          ++f.missing;
+        } else if (z < z_model - tol) {
+          ++f.occluded;
+        } else if (z > z_model + tol) {
+          ++f.see_through;
+        } else {
+          ++f.agree;
+        }
       }
     }
   }

@@ -86,15 +86,30 @@ std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFram
   }
   const double lim_a = f.half_a + margin, lim_b = f.half_b + margin;
   const double in_a = f.half_a - margin, in_b = f.half_b - margin;
+  // The grid is kept only near the sides: pixels well inside the image of
+  // the inner rectangle (a pixel to spare) need no ray-plane intersection.
+  std::array<Eigen::Vector2d, 4> inner;
+  bool has_inner = in_a > 0.0 && in_b > 0.0;
+  const double ia[4] = {-1.0, 1.0, 1.0, -1.0}, ib[4] = {-1.0, -1.0, 1.0, 1.0};
+  for (int c = 0; c < 4 && has_inner; ++c) {
+    const Eigen::Vector3d p = f.c + ia[c] * in_a * f.a + ib[c] * in_b * f.b;
+    has_inner = p.z() > 0.05;
+    inner[c] = has_inner ? Project(k, p) : Eigen::Vector2d::Zero();
+  }
   for (int v = va; v <= vb; ++v) {
     const double y = PixelRay(k, 0, v).y();
     const double a_row = f.a.y() * y + f.a.z(), b_row = f.b.y() * y + f.b.z(),
                  n_row = f.n.y() * y + f.n.z();
     const float* zrow = &depth.z[static_cast<size_t>(v) * k.width];
+    double skip0 = 0.0, skip1 = 0.0;  // (skip0, skip1): no grid
+    if (has_inner && QuadRowSpan(inner, v, &skip0, &skip1)) {
+      skip0 += 1.0;
+      skip1 -= 1.0;
+    }
     for (int u = ua; u <= ub; ++u) {
       const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row,
                    n_r = n_x[u - ua] + n_row;
-      if (std::abs(n_r) > 1e-6) {
+      if ((u <= skip0 || u >= skip1) && std::abs(n_r) > 1e-6) {
         const double t = n_c / n_r;
         const FacePoint q{t * a_r - a_c, t * b_r - b_c, 0.0};
         const double qa = std::abs(q.a), qb = std::abs(q.b);

@@ -64,6 +64,20 @@ std::optional<PixelRect> ProjectedRect(const CameraIntrinsics& k,
   return r;
 }
 
+bool QuadRowSpan(const std::array<Eigen::Vector2d, 4>& quad, double y, double* x0, double* x1) {
+  *x0 = std::numeric_limits<double>::max();
+  *x1 = -std::numeric_limits<double>::max();
+  for (int c = 0; c < 4; ++c) {
+    const Eigen::Vector2d& p = quad[c];
+    const Eigen::Vector2d& q = quad[(c + 1) % 4];
+    if ((p.y() > y) == (q.y() > y)) continue;  // the edge does not cross the row
+    const double x = p.x() + (y - p.y()) * (q.x() - p.x()) / (q.y() - p.y());
+    *x0 = std::min(*x0, x);
+    *x1 = std::max(*x1, x);
+  }
+  return *x0 < *x1;
+}
+
 DepthImage MakeDepthImage(const PointCloud& cloud, const CameraIntrinsics& k) {
   DepthImage image;
   image.camera = k;

@@ -2,6 +2,7 @@
 // used to project hypotheses back into the image.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -35,6 +36,10 @@ struct PixelRect {
 };
 std::optional<PixelRect> ProjectedRect(const CameraIntrinsics& k,
                                        const std::vector<Eigen::Vector3d>& points);
+
+// Where the row y crosses a convex quad (image coordinates, corners in
+// order): [*x0, *x1); false when it does not.
+bool QuadRowSpan(const std::array<Eigen::Vector2d, 4>& quad, double y, double* x0, double* x1);
 
 // An organized depth image of a cloud: for an organized cloud its z values;
 // for an unorganized one a z-buffer of its points projected through `k`
