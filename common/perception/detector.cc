@@ -7,6 +7,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -315,7 +316,10 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   }
   DetectorOptions options = options_in;
   options.edge_points.num_threads = options.num_threads;
-  options.segments.num_threads = options.num_threads;
+  // With face proposals, one thread finds the planar patches while the
+  // others fit the segments (below).
+  options.segments.num_threads =
+      options.face_proposals ? std::max(1, options.num_threads - 1) : options.num_threads;
   Detection det;
 
   // Preprocess: the camera and its depth image.
@@ -367,6 +371,26 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   det.edge_points = edges->points;
   det.timings.edge_points_ms = MsSince(t0);
 
+  // The planar patches and their tilings need only the depth image: they
+  // are found on a thread of their own while the edge points become
+  // segments and corners.
+  FaceProposals faces;
+  std::thread faces_thread;
+  if (options.face_proposals) {
+    faces_thread = std::thread([&] {
+      const Clock::time_point t_faces = Clock::now();
+      faces = ProposeFromFaces(depth, options.box, options.faces);
+      det.timings.faces_ms = MsSince(t_faces);
+    });
+  }
+  // Joined on every path out (an error below returns early).
+  struct Join {
+    std::thread& t;
+    ~Join() {
+      if (t.joinable()) t.join();
+    }
+  } join_faces{faces_thread};
+
   t0 = Clock::now();
   absl::StatusOr<std::vector<EdgeSegment>> segments =
       FitEdgeSegments(det.edge_points, options.segments);
@@ -394,12 +418,7 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   std::vector<DeclinedCandidate> declined;
   // Planar patches and their tilings first: every hypothesis, corner or
   // face, is checked against the layer its face lies on.
-  FaceProposals faces;
-  if (options.face_proposals) {
-    const Clock::time_point t_faces = Clock::now();
-    faces = ProposeFromFaces(depth, options.box, options.faces);
-    det.timings.faces_ms = MsSince(t_faces);
-  }
+  if (faces_thread.joinable()) faces_thread.join();
   internal::HypothesisJudge judge(depth, options);
   std::vector<std::array<SideKind, 4>> sides_of;  // per det.boxes entry
   for (const Corner& c : det.corners) {
