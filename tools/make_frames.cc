@@ -32,8 +32,8 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
-#include "common/io/cloud_io.h"
 #include "common/box/box_models.h"
+#include "common/io/cloud_io.h"
 #include "common/io/png_io.h"
 #include "tests/support/scene_generator.h"
 #include "tests/support/scene_kinds.h"
@@ -122,7 +122,8 @@ int Run(const Args& a) {
                                                  : a.kind;
     const uint32_t seed = a.seed * 1000 + i;
     std::string type;
-    absl::StatusOr<testing::Scene> scene = testing::MakeSceneOfKind(kind, *dims, i, seed, placement, &type);
+    absl::StatusOr<testing::Scene> scene =
+        testing::MakeSceneOfKind(kind, *dims, i, seed, placement, &type);
     if (!scene.ok()) {
       std::fprintf(stderr, "make_frames: %s\n", scene.status().ToString().c_str());
       return 2;
@@ -138,7 +139,8 @@ int Run(const Args& a) {
     const std::string base = a.out + "/" + id;
     absl::Status s = WriteDepthPng(base + ".png", depth, r.camera.width, r.camera.height);
     if (s.ok() && a.color) s = SaveColorPng(base + ".color.png", r.cloud);
-    if (s.ok() && a.pcd) s = a.color ? SaveColorPcd(base + ".pcd", r.cloud) : SavePcd(base + ".pcd", r.cloud);
+    if (s.ok() && a.pcd)
+      s = a.color ? SaveColorPcd(base + ".pcd", r.cloud) : SavePcd(base + ".pcd", r.cloud);
     if (!s.ok()) {
       std::fprintf(stderr, "make_frames: %s\n", s.ToString().c_str());
       return 1;

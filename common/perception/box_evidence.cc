@@ -57,8 +57,7 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
   const Eigen::Vector3d slab_lo = -half - origin, slab_hi = half - origin;
   auto cast_ray = [&](const Eigen::Vector3d& ray, double* t, int* face) {
     const Eigen::Vector3d dir = box_R_camera * ray;
-    double t_near = -std::numeric_limits<double>::max(),
-           t_far = std::numeric_limits<double>::max();
+    double t_near = -std::numeric_limits<double>::max(), t_far = std::numeric_limits<double>::max();
     int near_axis = -1;
     for (int a = 0; a < 3; ++a) {
       if (std::abs(dir[a]) < 1e-12) {
@@ -97,8 +96,8 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
     if (margin_px <= 0.0) return false;
     double t;
     int face;
-    for (const auto& [du, dv] : {std::pair{1.0, 0.0}, std::pair{-1.0, 0.0}, std::pair{0.0, 1.0},
-                                 std::pair{0.0, -1.0}}) {
+    for (const auto& [du, dv] :
+         {std::pair{1.0, 0.0}, std::pair{-1.0, 0.0}, std::pair{0.0, 1.0}, std::pair{0.0, -1.0}}) {
       if (!cast(u + du * margin_px, v + dv * margin_px, &t, &face)) return true;
     }
     return false;

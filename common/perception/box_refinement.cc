@@ -107,8 +107,7 @@ std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFram
       skip1 -= 1.0;
     }
     for (int u = ua; u <= ub; ++u) {
-      const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row,
-                   n_r = n_x[u - ua] + n_row;
+      const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row, n_r = n_x[u - ua] + n_row;
       if ((u <= skip0 || u >= skip1) && std::abs(n_r) > 1e-6) {
         const double t = n_c / n_r;
         const FacePoint q{t * a_r - a_c, t * b_r - b_c, 0.0};

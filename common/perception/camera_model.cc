@@ -91,7 +91,8 @@ DepthImage MakeDepthImage(const PointCloud& cloud, const CameraIntrinsics& k) {
       image.grey.resize(cloud.size());
       for (size_t i = 0; i < cloud.size(); ++i) {
         const uint32_t c = cloud.rgb[i];
-        image.grey[i] = static_cast<float>(((c >> 16) & 0xFF) + ((c >> 8) & 0xFF) + (c & 0xFF)) / 3.0f;
+        image.grey[i] =
+            static_cast<float>(((c >> 16) & 0xFF) + ((c >> 8) & 0xFF) + (c & 0xFF)) / 3.0f;
       }
     }
     return image;

@@ -277,8 +277,8 @@ absl::Status DetectorOptions::Validate() const {
         absl::StrCat("size_tolerance_m=", *size_tolerance_m, " is outside (0, 0.1]"));
   }
   if (!(edge_lattice_radius_px >= 0.0 && edge_lattice_radius_px <= 100.0)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "edge_lattice_radius_px=", edge_lattice_radius_px, " is outside [0, 100]"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("edge_lattice_radius_px=", edge_lattice_radius_px, " is outside [0, 100]"));
   }
   if (max_declined < 0 || max_declined > 1000) {
     return absl::InvalidArgumentError(

@@ -215,8 +215,7 @@ class OrganizedScorer {
     size_t k = 0;
 #if defined(__SSE2__)
     const __m128 cx = _mm_set1_ps(centre.x()), cy = _mm_set1_ps(centre.y()),
-                 cz = _mm_set1_ps(centre.z()), r2 = _mm_set1_ps(radius2_),
-                 zero = _mm_setzero_ps();
+                 cz = _mm_set1_ps(centre.z()), r2 = _mm_set1_ps(radius2_), zero = _mm_setzero_ps();
     __m128 sx = zero, sy = zero, sz = zero;
     int count = 0;
     for (; k + 4 <= m; k += 4) {

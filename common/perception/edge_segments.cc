@@ -121,8 +121,8 @@ class SegmentFitter {
       // A uniform random subset: the first ransac_subset of a partial
       // Fisher-Yates shuffle.
       for (int i = 0; i < options_.ransac_subset; ++i) {
-        const int j = std::uniform_int_distribution<int>(
-            i, static_cast<int>(subset.size()) - 1)(rng_);
+        const int j =
+            std::uniform_int_distribution<int>(i, static_cast<int>(subset.size()) - 1)(rng_);
         std::swap(subset[i], subset[j]);
       }
       subset.resize(options_.ransac_subset);
@@ -165,8 +165,8 @@ class SegmentFitter {
           if (d2 >= min2 && d2 <= max2) candidates.push_back(i);
         });
         if (candidates.empty()) continue;
-        const size_t k = std::min(candidates.size() - 1,
-                                  static_cast<size_t>(second[it] * candidates.size()));
+        const size_t k =
+            std::min(candidates.size() - 1, static_cast<size_t>(second[it] * candidates.size()));
         lines[it].point = pts_[a];
         lines[it].direction = (pts_[candidates[k]] - pts_[a]).normalized();
         counts[it] = CountWithin(lines[it], t2);

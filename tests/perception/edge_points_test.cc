@@ -1,5 +1,4 @@
 #include "common/perception/edge_points.h"
-#include "common/perception/internal/select_kth.h"
 
 #include <gtest/gtest.h>
 
@@ -13,6 +12,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "common/perception/internal/select_kth.h"
 #include "tests/support/scene_generator.h"
 #include "tests/support/scene_kinds.h"
 #include "tests/support/sensor_options.h"
@@ -274,14 +274,13 @@ TEST(EdgePointsTest, SkippingLowCellsNextToHitsKeepsTheEdgePoints) {
         sensor.kind = sensor_kind;
         const CameraIntrinsics k = *SensorIntrinsics(sensor_kind, 640, 480);
         std::string type;
-        const absl::StatusOr<Scene> scene = MakeSceneOfKind(
-            kind, kCartonS, i, 500 + 10 * i, SensorPlacement(sensor_kind, k), &type);
+        const absl::StatusOr<Scene> scene = MakeSceneOfKind(kind, kCartonS, i, 500 + 10 * i,
+                                                            SensorPlacement(sensor_kind, k), &type);
         ASSERT_TRUE(scene.ok()) << scene.status();
         const RenderedScene out = Render(*scene, sensor);
         EdgePointOptions every_cell;
         every_cell.coarse_skip_factor = 0.0;
-        const absl::StatusOr<EdgePoints> a =
-            DetectEdgePoints(out.cloud, every_cell, out.camera.fx);
+        const absl::StatusOr<EdgePoints> a = DetectEdgePoints(out.cloud, every_cell, out.camera.fx);
         EdgePointOptions skipping;
         skipping.coarse_skip_factor = 0.5;
         const absl::StatusOr<EdgePoints> b = DetectEdgePoints(out.cloud, skipping, out.camera.fx);

@@ -21,8 +21,8 @@ absl::StatusOr<Scene> MakeSceneOfKind(const std::string& kind, const BoxDims& di
     return scene;
   }
   if (kind == "pallet") {
-    return MakePalletScene(dims, 3 + i % 2, 2 + i % 3, 1 + i % 2,
-                                    0.002 + 0.001 * (i % 3), i % 4, seed, place);
+    return MakePalletScene(dims, 3 + i % 2, 2 + i % 3, 1 + i % 2, 0.002 + 0.001 * (i % 3), i % 4,
+                           seed, place);
   }
   if (kind == "touching" || kind == "touching1" || kind == "touching2") {
     *type = "pallet";
@@ -37,8 +37,8 @@ absl::StatusOr<Scene> MakeSceneOfKind(const std::string& kind, const BoxDims& di
     // 1-3 boxes of another size, at most a fifth of the layer.
     const int distractors = std::min(1 + i % 3, std::max(1, rows * cols / 5));
     const double gap = 0.001 * ((i + i / 4) % 4);  // 0-3 mm
-    return MakeDistractorPalletScene(dims, rows, cols, layers, gap, removed,
-                                              distractors, seed, place);
+    return MakeDistractorPalletScene(dims, rows, cols, layers, gap, removed, distractors, seed,
+                                     place);
   }
   return absl::InvalidArgumentError("unknown --kind " + kind);
 }

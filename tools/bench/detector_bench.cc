@@ -14,14 +14,14 @@
 // correct / pickable boxes over the set.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <algorithm>
-#include <vector>
 #include <string>
+#include <vector>
 
-#include "common/io/cloud_io.h"
 #include "common/box/box_models.h"
+#include "common/io/cloud_io.h"
 #include "common/perception/detector.h"
 #include "common/perception/pose_error.h"
 #include "tests/support/scene_generator.h"
