@@ -353,12 +353,11 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   }
   const PointCloud& work = project ? projected : cloud;
   const DepthImage depth = MakeDepthImage(work, camera);
-  if (options.parameters_from_geometry) {
-    DeriveGeometryParameters(MedianDepth(depth.z), camera.fx, &options);
-  }
+  const double median_z = MedianDepth(depth.z);
+  if (options.parameters_from_geometry) DeriveGeometryParameters(median_z, camera.fx, &options);
   if (options.size_tolerance_m) ApplySizeTolerance(*options.size_tolerance_m, &options);
   if (options.edge_lattice_radius_px > 0.0) {
-    const double z = MedianDepth(depth.z);
+    const double z = median_z;
     const double radius_px = z > 0.0 ? options.edge_points.radius_m * camera.fx / z : 0.0;
     options.edge_points.lattice_px = std::clamp(
         static_cast<int>(radius_px / options.edge_lattice_radius_px), 1, kMaxEdgeLattice);
@@ -374,22 +373,16 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   // The planar patches and their tilings need only the depth image: they
   // are found on a thread of their own while the edge points become
   // segments and corners.
+  // (A jthread: joined on every path out, an error below returns early.)
   FaceProposals faces;
-  std::thread faces_thread;
+  std::jthread faces_thread;
   if (options.face_proposals) {
-    faces_thread = std::thread([&] {
+    faces_thread = std::jthread([&] {
       const Clock::time_point t_faces = Clock::now();
       faces = ProposeFromFaces(depth, options.box, options.faces);
       det.timings.faces_ms = MsSince(t_faces);
     });
   }
-  // Joined on every path out (an error below returns early).
-  struct Join {
-    std::thread& t;
-    ~Join() {
-      if (t.joinable()) t.join();
-    }
-  } join_faces{faces_thread};
 
   t0 = Clock::now();
   absl::StatusOr<std::vector<EdgeSegment>> segments =

@@ -1,11 +1,10 @@
 #include "common/perception/internal/hypothesis_judge.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <thread>
 
 #include "absl/strings/str_format.h"
+#include "common/perception/internal/parallel.h"
 #include "common/perception/pose_error.h"
 
 namespace cornerpose::internal {
@@ -23,12 +22,12 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
   const double grasp_occluded = static_cast<double>(g.occluded) / g.expected;
   const double grasp_support = g.visible() > 0 ? static_cast<double>(g.agree) / g.visible() : 0.0;
   if (grasp_occluded > o.max_grasp_occluded) {
-    return reject(absl::StrFormat("grasp face %.0f%% hidden by something in front",
-                                  100 * grasp_occluded));
+    return reject(
+        absl::StrFormat("grasp face %.0f%% hidden by something in front", 100 * grasp_occluded));
   }
   if (grasp_support < o.min_grasp_support) {
-    return reject(absl::StrFormat("grasp face only %.0f%% confirmed by the depth",
-                                  100 * grasp_support));
+    return reject(
+        absl::StrFormat("grasp face only %.0f%% confirmed by the depth", 100 * grasp_support));
   }
   if (ev.support() < o.min_support) {
     return reject(absl::StrFormat("box only %.0f%% confirmed by the depth", 100 * ev.support()));
@@ -48,10 +47,11 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
   // each of the face's axes.
   const int fi = static_cast<int>(grasp);
   const int axis_a = (fi / 2 + 1) % 3, axis_b = (fi / 2 + 2) % 3;
-  for (const auto& [extent, axis] : {std::pair{ref.extent_a_m, axis_a}, std::pair{ref.extent_b_m, axis_b}}) {
+  for (const auto& [extent, axis] :
+       {std::pair{ref.extent_a_m, axis_a}, std::pair{ref.extent_b_m, axis_b}}) {
     if (extent > 0.0 && std::abs(extent - dims[axis]) > o.extent_tolerance_m) {
-      return reject(absl::StrFormat("face measures %.3f m where the box is %.3f m", extent,
-                                    dims[axis]));
+      return reject(
+          absl::StrFormat("face measures %.3f m where the box is %.3f m", extent, dims[axis]));
     }
   }
   // Every side that can be seen must end the face: a free border or a seam
@@ -59,8 +59,9 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
   int measured = 0;
   for (SideKind k : ref.sides) {
     if (k == SideKind::kContinues) {
-      return reject("a side runs on flat with no seam (a bigger face, or a layer that does not "
-                    "tile uniquely)");
+      return reject(
+          "a side runs on flat with no seam (a bigger face, or a layer that does not "
+          "tile uniquely)");
     }
     measured += k == SideKind::kFree || k == SideKind::kSeam || k == SideKind::kTiled;
   }
@@ -105,26 +106,19 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
   std::vector<char> accepted(n, 0), refined(n, 0);
   std::vector<std::string> reasons(n);
   // Work is uneven (most hypotheses fail the first check), so threads take
-  // the next hypothesis from a shared counter.
-  std::atomic<int> next{0};
-  auto worker = [&] {
-    for (int i = next++; i < n; i = next++) {
-      bool r = false;
-      accepted[i] = EvaluateOne(queue_[i], &results[i], &r, &reasons[i]);
-      refined[i] = r;
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::min(threads, n); ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
+  // the next hypothesis when done with one.
+  ParallelForChunks(n, 1, threads, [&](int, int i, int) {
+    bool r = false;
+    accepted[i] = EvaluateOne(queue_[i], &results[i], &r, &reasons[i]);
+    refined[i] = r;
+  });
   std::vector<Candidate> out;
   for (int i = 0; i < n; ++i) {
     stats_.refined += refined[i];
     if (!accepted[i]) {
       if (refined[i]) {
-        declined_.push_back({results[i].box.camera_T_box, results[i].box.score,
-                             std::move(reasons[i])});
+        declined_.push_back(
+            {results[i].box.camera_T_box, results[i].box.score, std::move(reasons[i])});
       }
       continue;
     }
