@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
@@ -9,6 +10,7 @@
 #include "robot_client/planning/grasp_geometry.h"
 #include "robot_client/planning/pick_selection.h"
 #include "robot_client/planning/place_pattern.h"
+#include "robot_client/planning/planning_scene.h"
 #include "robot_client/planning/urscript_program.h"
 #include "robot_client/ur/dashboard.h"
 
@@ -351,8 +353,16 @@ std::optional<CellController::PreparedPick> CellController::PreparePick(const Fr
     Note(absl::StrCat(frame_name, ": ", DescribeRejections(selection)));
     return std::nullopt;
   }
+  // Free moves keep clear of the pile this frame shows and of the boxes
+  // placed so far.
+  std::vector<BoxInBase> seen;
+  for (const BoxVerdict& verdict : selection.verdicts) seen.push_back(verdict.box);
+  PlanningScene scene =
+      ScenePerPick(seen, dims, options_.place_pattern, slot, options_.workspace.min_m.z());
+  DropWhatTheArmOccupies(options_.robot.arm_model, options_.gripper.flange_T_tcp, joints,
+                         CollisionCheckOptions{}, scene);
   PlannedPick planned = PlanFirstPlannable(selection, [&](const BoxInBase& box) {
-    return PlanPickForSlot(options_, joints, box, slot, dims);
+    return PlanPickForSlot(options_, joints, box, slot, dims, &scene);
   });
   if (planned.chosen == nullptr) {
     Note(

@@ -82,7 +82,7 @@ double PlaceApproachHeight(const BoxInBase& box, const WaypointOptions& waypoint
 namespace {
 
 // The waypoints of one choice of grasp and place orientation.
-PickPlan Waypoints(const Eigen::Isometry3d& initial, const BoxInBase& box,
+PickPlan Waypoints(const Eigen::Isometry3d& initial, const BoxInBase& box, const BoxDims& dims,
                    const Eigen::Isometry3d& grasp, const Eigen::Isometry3d& base_T_slot,
                    const Eigen::Isometry3d& slot_T_box, int slot,
                    const WaypointOptions& waypoints) {
@@ -94,6 +94,7 @@ PickPlan Waypoints(const Eigen::Isometry3d& initial, const BoxInBase& box,
   plan.slot = slot;
   plan.base_T_slot = base_T_slot;
   plan.box = box;
+  plan.box_dims = dims;
   plan.tcp_T_box = grasp.inverse() * box.base_T_box;
   plan.base_T_box_placed = base_T_slot * slot_T_box;
   plan.place = plan.base_T_box_placed * plan.tcp_T_box.inverse();
@@ -196,10 +197,14 @@ absl::Status StraightMove(const PickArm& arm, const char* name, const Eigen::Iso
 }
 
 // The pick half as the controller runs it: I -> M (movej), M -> G, G -> R.
-absl::Status SimulatePick(const PickArm& arm, PickPlan& plan) {
+absl::Status SimulatePick(const PickArm& arm, const PlanningScene* scene, PickPlan& plan) {
   plan.initial_joints = arm.joints;
   absl::Status status =
       FreeMove(arm, "M (approach)", plan.approach, plan.initial_joints, &plan.approach_joints);
+  if (status.ok() && scene != nullptr) {
+    status = CheckFreeMove(arm.model, arm.flange_T_tcp, plan.initial_joints, plan.approach_joints,
+                           std::nullopt, *scene, arm.free_moves, "I->M (approach)");
+  }
   if (status.ok()) {
     status = StraightMove(arm, "M->G (grasp)", plan.approach, plan.grasp, plan.approach_joints,
                           &plan.grasp_joints);
@@ -211,10 +216,53 @@ absl::Status SimulatePick(const PickArm& arm, PickPlan& plan) {
   return status;
 }
 
-// The place half: R -> place_above (movej), place_above -> F and back.
-absl::Status SimulatePlace(const PickArm& arm, PickPlan& plan) {
+// Transit heights above R's tried in turn, m.
+constexpr std::array<double, 4> kTransitRaises = {0.0, 0.1, 0.2, 0.3};
+
+// R -> place_above clear of the scene: directly, or through T (see the
+// header). Sets place_above_joints, and transit when it takes one.
+absl::Status CarryClear(const PickArm& arm, const PlanningScene& scene,
+                        const Workspace& workspace, PickPlan& plan) {
+  const HeldBox held{plan.box_dims, plan.tcp_T_box};
+  absl::Status direct = CheckFreeMove(arm.model, arm.flange_T_tcp, plan.retrieve_joints,
+                                      plan.place_above_joints, held, scene, arm.free_moves,
+                                      "R->place_above");
+  if (direct.ok()) return direct;
+  const double base_z = std::max(plan.retrieve.translation().z(), plan.place_above.translation().z());
+  for (double raise : kTransitRaises) {
+    Eigen::Isometry3d transit = plan.place_above;
+    transit.translation().z() = base_z + raise;
+    if (!workspace.Contains(transit.translation())) break;
+    ur::Joints transit_joints{}, place_above_joints{};
+    if (!FreeMove(arm, "T (transit)", transit, plan.retrieve_joints, &transit_joints).ok()) continue;
+    if (!CheckFreeMove(arm.model, arm.flange_T_tcp, plan.retrieve_joints, transit_joints, held,
+                       scene, arm.free_moves, "R->T")
+             .ok()) {
+      continue;
+    }
+    if (!FreeMove(arm, "place_above", plan.place_above, transit_joints, &place_above_joints).ok() ||
+        !CheckFreeMove(arm.model, arm.flange_T_tcp, transit_joints, place_above_joints, held, scene,
+                       arm.free_moves, "T->place_above")
+             .ok()) {
+      continue;
+    }
+    plan.transit = transit;
+    plan.transit_joints = transit_joints;
+    plan.place_above_joints = place_above_joints;
+    return absl::OkStatus();
+  }
+  return absl::FailedPreconditionError(absl::StrCat(
+      direct.message(), ", and no transit above the slot (up to 0.3 m above R) is clear"));
+}
+
+// The place half: R -> place_above (movej, through T when needed),
+// place_above -> F and back.
+absl::Status SimulatePlace(const PickArm& arm, const PlanningScene* scene,
+                           const Workspace& workspace, PickPlan& plan) {
+  plan.transit.reset();
   absl::Status status = FreeMove(arm, "place_above", plan.place_above, plan.retrieve_joints,
                                  &plan.place_above_joints);
+  if (status.ok() && scene != nullptr) status = CarryClear(arm, *scene, workspace, plan);
   if (status.ok()) {
     status = StraightMove(arm, "place_above->F (place)", plan.place_above, plan.place,
                           plan.place_above_joints, &plan.place_joints);
@@ -231,7 +279,8 @@ absl::Status SimulatePlace(const PickArm& arm, PickPlan& plan) {
 
 absl::StatusOr<PickPlan> PlanPick(const PickArm& arm, const BoxInBase& box, const BoxDims& dims,
                                   const Eigen::Isometry3d& base_T_slot, int slot,
-                                  const WaypointOptions& waypoints, const Workspace& workspace) {
+                                  const WaypointOptions& waypoints, const Workspace& workspace,
+                                  const PlanningScene* scene) {
   const Eigen::Isometry3d initial = TcpPoseFromJoints(arm.model, arm.joints, arm.flange_T_tcp);
   const std::array<Eigen::Isometry3d, 4> grasps =
       GraspCandidates(box, Eigen::Quaterniond(initial.linear()));
@@ -240,7 +289,7 @@ absl::StatusOr<PickPlan> PlanPick(const PickArm& arm, const BoxInBase& box, cons
   // Positions do not depend on the orientation choice: one workspace check.
   {
     const PickPlan plan =
-        Waypoints(initial, box, grasps[0], base_T_slot, places[0], slot, waypoints);
+        Waypoints(initial, box, dims, grasps[0], base_T_slot, places[0], slot, waypoints);
     for (const auto& [name, pose] : Commanded(plan)) {
       if (!workspace.Contains(pose->translation())) {
         return absl::FailedPreconditionError(
@@ -256,14 +305,14 @@ absl::StatusOr<PickPlan> PlanPick(const PickArm& arm, const BoxInBase& box, cons
     std::vector<PickPlan> candidates;
     for (const Eigen::Isometry3d& slot_T_box : places) {
       candidates.push_back(
-          Waypoints(initial, box, grasp, base_T_slot, slot_T_box, slot, waypoints));
+          Waypoints(initial, box, dims, grasp, base_T_slot, slot_T_box, slot, waypoints));
     }
     std::stable_sort(candidates.begin(), candidates.end(),
                      [](const PickPlan& a, const PickPlan& b) {
                        return a.place_rotation_rad < b.place_rotation_rad;
                      });
     // The pick half is the same for every place orientation.
-    absl::Status status = SimulatePick(arm, candidates.front());
+    absl::Status status = SimulatePick(arm, scene, candidates.front());
     if (!status.ok()) {
       if (status.code() != absl::StatusCode::kFailedPrecondition) return status;
       if (first_failure.ok()) first_failure = status;
@@ -274,7 +323,7 @@ absl::StatusOr<PickPlan> PlanPick(const PickArm& arm, const BoxInBase& box, cons
       plan.approach_joints = candidates.front().approach_joints;
       plan.grasp_joints = candidates.front().grasp_joints;
       plan.retrieve_joints = candidates.front().retrieve_joints;
-      status = SimulatePlace(arm, plan);
+      status = SimulatePlace(arm, scene, workspace, plan);
       if (status.ok()) return plan;
       if (status.code() != absl::StatusCode::kFailedPrecondition) return status;
       if (first_failure.ok()) first_failure = status;
@@ -292,7 +341,8 @@ absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
 
 absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
                                          const ur::Joints& current_joints, const BoxInBase& box,
-                                         int slot, const BoxDims& dims) {
+                                         int slot, const BoxDims& dims,
+                                         const PlanningScene* scene) {
   absl::StatusOr<Eigen::Isometry3d> base_T_slot = SlotPose(options.place_pattern, slot);
   if (!base_T_slot.ok()) return base_T_slot.status();
   PickArm arm;
@@ -301,7 +351,7 @@ absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
   arm.joints = current_joints;
   arm.branch_reference = options.clear_joints;
   arm.straight_moves.linear_speed_m_s = options.motion.linear_speed_m_s;
-  return PlanPick(arm, box, dims, *base_T_slot, slot, options.waypoints, options.workspace);
+  return PlanPick(arm, box, dims, *base_T_slot, slot, options.waypoints, options.workspace, scene);
 }
 
 }  // namespace cornerpose::robot_client

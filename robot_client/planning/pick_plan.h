@@ -8,7 +8,9 @@
 //      -normal), tool x along one of the face's box axes: of the four, the
 //      one needing the least wrist rotation from I; M -> G is straight
 //   R  = G + h * base z         retrieve, straight up from G
-//   place_above = F + a * base z, reached by a free move from R
+//   place_above = F + a * base z, reached by a free move from R (through
+//      the transit waypoint T when the direct one would pass too close to
+//      the scene: see below)
 //   F  the place: the TCP pose that puts the held box's bottom centre on the
 //      slot, grasped face up, the face's longer side along the slot's x axis
 //      (of the two, or four for a square face, such box orientations the one
@@ -26,6 +28,14 @@
 // Heights come from the pile when the box carries its top
 // (BoxInBase::pile_top_z_m): M at least pile_clearance_m above the pile's
 // top, R high enough that the held box's bottom clears it by as much.
+//
+// Given a planning scene (planning_scene.h), the free moves I -> M and
+// R -> place_above are checked along their joint-space path against it (the
+// arm's links, and from G on the held box). When R -> place_above is not
+// clear — a place lower than R makes the joint-space path sink towards the
+// pile on the way out — the program goes through a transit waypoint T above
+// the slot, at R's height or higher (R, +0.1, +0.2, +0.3 m, the first whose
+// moves R -> T and T -> place_above are clear and reachable).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -35,6 +45,7 @@
 #include "common/box/box_types.h"
 #include "robot_client/config/robot_config.h"
 #include "robot_client/planning/grasp_geometry.h"
+#include "robot_client/planning/planning_scene.h"
 #include "robot_client/planning/straight_move.h"
 #include "robot_client/ur/kinematics.h"
 
@@ -46,13 +57,17 @@ struct PickPlan {
   Eigen::Isometry3d approach = Eigen::Isometry3d::Identity();     // M
   Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();        // G
   Eigen::Isometry3d retrieve = Eigen::Isometry3d::Identity();     // R
+  // T, when the free move R -> place_above needs one (see above).
+  std::optional<Eigen::Isometry3d> transit;
   Eigen::Isometry3d place_above = Eigen::Isometry3d::Identity();  // above F
   Eigen::Isometry3d place = Eigen::Isometry3d::Identity();        // F
   // The place pattern slot F fills, and its pose (the box's bottom centre).
   int slot = 0;
   Eigen::Isometry3d base_T_slot = Eigen::Isometry3d::Identity();
-  // The box as picked, and where it ends up (base_T_box at F).
+  // The box as picked (of size box_dims), and where it ends up (base_T_box
+  // at F).
   BoxInBase box;
+  BoxDims box_dims;
   Eigen::Isometry3d base_T_box_placed = Eigen::Isometry3d::Identity();
   // The held box in the tool frame, from G on.
   Eigen::Isometry3d tcp_T_box = Eigen::Isometry3d::Identity();
@@ -66,6 +81,7 @@ struct PickPlan {
   ur::Joints approach_joints{};
   ur::Joints grasp_joints{};
   ur::Joints retrieve_joints{};
+  ur::Joints transit_joints{};  // meaningful when transit is set
   ur::Joints place_above_joints{};
   ur::Joints place_joints{};
 };
@@ -84,6 +100,8 @@ struct PickArm {
   // How straight moves are checked; linear_speed_m_s should be the
   // program's (MotionOptions::linear_speed_m_s).
   StraightMoveOptions straight_moves;
+  // How free moves are checked against the planning scene.
+  CollisionCheckOptions free_moves;
 };
 
 // Plans the waypoints for `box` (a box of size `dims`, see BoxToBase) into
@@ -99,10 +117,14 @@ struct PickArm {
 // of the preferred choice: "waypoint M (approach) at (...) is not
 // reachable" or "straight move G->R (retrieve) passes a singularity at
 // (...): ..." (the moves: M->G (grasp), G->R (retrieve), place_above->F
-// (place), F->place_above (leave)).
+// (place), F->place_above (leave)), or "free move I->M (approach): the
+// wrist_2 comes within 0.020 m of the pile at (...)" when `scene` is given
+// and a free move cannot be made clear of it. No scene: free moves are not
+// checked for contact.
 absl::StatusOr<PickPlan> PlanPick(const PickArm& arm, const BoxInBase& box, const BoxDims& dims,
                                   const Eigen::Isometry3d& base_T_slot, int slot,
-                                  const WaypointOptions& waypoints, const Workspace& workspace);
+                                  const WaypointOptions& waypoints, const Workspace& workspace,
+                                  const PlanningScene* scene = nullptr);
 
 // The approach distance d (M = G + d z) and retrieve height h (R = G + h z)
 // for `box`: approach_distance_m and retrieve_height_m, raised when the
@@ -119,10 +141,12 @@ double PlaceApproachHeight(const BoxInBase& box, const WaypointOptions& waypoint
 // gripper's TCP offset, `current_joints`, the clear pose as the branch
 // reference, the motion's linear speed and the
 // slot pose from the place pattern (RESOURCE_EXHAUSTED when `slot` is past
-// its end), for a box of `dims` (the size the server detected with).
+// its end), for a box of `dims` (the size the server detected with), with
+// free moves checked against `scene` when given.
 absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
                                          const ur::Joints& current_joints, const BoxInBase& box,
-                                         int slot, const BoxDims& dims);
+                                         int slot, const BoxDims& dims,
+                                         const PlanningScene* scene = nullptr);
 // The same for the configured box size, options.perception.box.
 absl::StatusOr<PickPlan> PlanPickForSlot(const RobotClientOptions& options,
                                          const ur::Joints& current_joints, const BoxInBase& box,

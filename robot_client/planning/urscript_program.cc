@@ -19,6 +19,8 @@ namespace {
 //   ${approach}            M, pose literal, base frame (m, rad)
 //   ${grasp}               G, pose literal
 //   ${retrieve}            R, pose literal
+//   ${transit_move}        "  movej(T's joints, ...)\n" when the plan has a
+//                          transit waypoint T, else nothing
 //   ${place_above_joints}  above F, joint vector literal (rad)
 //   ${place_above}         above F, pose literal
 //   ${place}               F, pose literal
@@ -39,7 +41,7 @@ constexpr absl::string_view kPickProgramTemplate = R"(def ${name}():
   ${suction_out}(${suction_index}, True)
   sleep(${grasp_settle})
   movel(${retrieve}, a=${linear_acceleration}, v=${linear_speed})
-  movej(${place_above_joints}, a=${joint_acceleration}, v=${joint_speed})
+${transit_move}  movej(${place_above_joints}, a=${joint_acceleration}, v=${joint_speed})
   movel(${place}, a=${linear_acceleration}, v=${linear_speed})
   ${suction_out}(${suction_index}, False)
   sleep(${release})
@@ -103,7 +105,8 @@ absl::StatusOr<std::string> RenderPickProgram(absl::string_view name, const Pick
   for (const auto& [what, joints] :
        {std::pair<const char*, const ur::Joints*>{"clear joints", &clear_joints},
         {"approach joints", &plan.approach_joints},
-        {"place_above joints", &plan.place_above_joints}}) {
+        {"place_above joints", &plan.place_above_joints},
+        {"transit joints", &plan.transit_joints}}) {
     for (double v : *joints) {
       if (!std::isfinite(v)) return absl::InvalidArgumentError(absl::StrCat(what, " are not finite"));
     }
@@ -114,6 +117,11 @@ absl::StatusOr<std::string> RenderPickProgram(absl::string_view name, const Pick
     if (!std::isfinite(v)) return absl::InvalidArgumentError("a speed or wait is not finite");
   }
   auto pose = [](const Eigen::Isometry3d& T) { return ur::FormatPoseLiteral(ur::ToUrPose(T)); };
+  const std::string transit_move =
+      plan.transit ? absl::StrCat("  movej(", ur::FormatJointsLiteral(plan.transit_joints),
+                                  ", a=", FormatNumber(motion.joint_acceleration_rad_s2),
+                                  ", v=", FormatNumber(motion.joint_speed_rad_s), ")\n")
+                   : std::string();
   const std::string text = absl::StrReplaceAll(
       kPickProgramTemplate,
       {
@@ -124,6 +132,7 @@ absl::StatusOr<std::string> RenderPickProgram(absl::string_view name, const Pick
           {"${approach}", pose(plan.approach)},
           {"${grasp}", pose(plan.grasp)},
           {"${retrieve}", pose(plan.retrieve)},
+          {"${transit_move}", transit_move},
           {"${place_above}", pose(plan.place_above)},
           {"${place}", pose(plan.place)},
           {"${clear_joints}", ur::FormatJointsLiteral(clear_joints)},

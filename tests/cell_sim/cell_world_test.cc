@@ -14,7 +14,6 @@
 #include "common/io/png_io.h"
 #include "robot_client/ur/kinematics.h"
 #include "robot_client/ur/pose.h"
-#include "tests/support/cell_sim/arm_capsules.h"
 #include "tests/support/cell_sim/sim_camera.h"
 #include "tests/support/cell_sim/sim_cell.h"
 #include "tests/support/ur_emulator/controller.h"

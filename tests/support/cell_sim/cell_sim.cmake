@@ -1,12 +1,11 @@
 # The simulated cell (tests/support/cell_sim): a world of boxes the UR
-# controller emulator acts on (suction, carrying, collisions through FCL) and
+# controller emulator acts on (suction, carrying, collisions through FCL, with the
+# daemon's own shapes: robot_client/collision) and
 # a depth camera rendering it into a frame directory; library, tests and the
 # `cell_sim` binary (scripts/demo). Included from tests/CMakeLists.txt after
 # the emulator (tests/ur).
-find_package(fcl REQUIRED)  # Debian: libfcl-dev
 set(CORNERPOSE_CELL_SIM_DIR ${PROJECT_SOURCE_DIR}/tests/support/cell_sim)
 add_library(cornerpose_cell_sim
-  ${CORNERPOSE_CELL_SIM_DIR}/arm_capsules.cc
   ${CORNERPOSE_CELL_SIM_DIR}/cell_world.cc
   ${CORNERPOSE_CELL_SIM_DIR}/geometry.cc
   ${CORNERPOSE_CELL_SIM_DIR}/sim_camera.cc
@@ -16,7 +15,7 @@ add_library(cornerpose_cell_sim
   ${PROJECT_SOURCE_DIR}/common/io/png_io.cc
 )
 target_link_libraries(cornerpose_cell_sim PUBLIC cornerpose_test_support cornerpose_ur_emulator
-                      PNG::PNG PRIVATE fcl)
+                      cornerpose_collision PNG::PNG)
 cornerpose_warnings(cornerpose_cell_sim)
 add_executable(cell_sim ${CORNERPOSE_CELL_SIM_DIR}/cell_sim_main.cc)
 target_link_libraries(cell_sim PRIVATE cornerpose_cell_sim absl::flags absl::flags_parse

@@ -16,7 +16,6 @@
 
 #include "absl/status/status.h"
 #include "absl/time/time.h"
-#include "tests/support/cell_sim/arm_capsules.h"
 #include "tests/support/cell_sim/geometry.h"
 #include "tests/support/scene_generator.h"
 #include "tests/support/ur_emulator/arm_world.h"

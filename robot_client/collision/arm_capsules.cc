@@ -1,8 +1,8 @@
-#include "tests/support/cell_sim/arm_capsules.h"
+#include "robot_client/collision/arm_capsules.h"
 
 #include <array>
 
-namespace cornerpose::cell_sim {
+namespace cornerpose::collision {
 namespace {
 
 // Offsets of the upper arm and forearm from the DH plane along the joint
@@ -61,4 +61,4 @@ std::vector<Capsule> ArmCapsules(ur::ArmModel model, const ur::Joints& q,
   return out;
 }
 
-}  // namespace cornerpose::cell_sim
+}  // namespace cornerpose::collision

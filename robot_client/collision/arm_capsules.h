@@ -8,10 +8,10 @@
 #include <Eigen/Geometry>
 #include <vector>
 
+#include "robot_client/collision/shapes.h"
 #include "robot_client/ur/kinematics.h"
-#include "tests/support/cell_sim/geometry.h"
 
-namespace cornerpose::cell_sim {
+namespace cornerpose::collision {
 
 struct ToolShape {
   // The suction tool from the flange to its tip, a capsule of this radius, m.
@@ -28,4 +28,4 @@ struct ToolShape {
 std::vector<Capsule> ArmCapsules(ur::ArmModel model, const ur::Joints& q,
                                  const Eigen::Isometry3d& flange_T_tcp, const ToolShape& tool);
 
-}  // namespace cornerpose::cell_sim
+}  // namespace cornerpose::collision
