@@ -441,8 +441,15 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   auto accept_all = [&] {
     std::vector<internal::Candidate> pending = judge.Evaluate(options.num_threads);
     while (!pending.empty()) {
+      // The reading whose face ends in more free borders goes first, then
+      // the higher score: a free border is measured, a seam or a tiling is
+      // inferred (two boxes on end side by side have a lying box's outline,
+      // and a Kinect's noise can make a seam of nothing in a face).
       std::stable_sort(pending.begin(), pending.end(),
                        [](const internal::Candidate& a, const internal::Candidate& b) {
+                         if (a.refinement.free_sides != b.refinement.free_sides) {
+                           return a.refinement.free_sides > b.refinement.free_sides;
+                         }
                          return a.box.score > b.box.score;
                        });
       for (internal::Candidate& c : pending) {
