@@ -219,7 +219,7 @@ absl::StatusOr<SimCell> MakeSimCell(const SimCellOptions& cell, const SimLoadOpt
                                      place_y - 0.5 * (out.place_rows - 1) * py,
                                      testing::kEurPalletHeight);
   out.place_origin_base = layout.world_T_base.inverse() * origin_world;
-  out.lift_height_m = std::max(0.35, (load.kind == "pallet" ? d.h : d.vec().maxCoeff()) + 0.20);
+  out.lift_height_m = (load.kind == "pallet" ? d.h : d.vec().maxCoeff()) + 0.05;
   return out;
 }
 
@@ -267,9 +267,11 @@ absl::StatusOr<std::string> RobotClientConfigText(const SimCell& cell, const std
       "gripper {\n  tcp_offset {\n    position { x: 0 y: 0 z: 0.10 }\n",
       "    rotation_vector { x: 0 y: 0 z: 0 }\n  }\n  suction_output: SUCTION_OUTPUT_KIND_TOOL\n",
       "  suction_output_index: 0\n  grasp_settle_s: 0.3\n  release_s: 0.3\n}\n\n",
-      "# The held box rises this far above its grasp (its bottom clears the boxes\n",
-      "# around it by 0.2 m or more) and comes down onto its slot from as high, so\n",
-      "# it never sweeps through the layer it joins.\n",
+      "# The held box rises at least this far above its grasp (its bottom 5 cm\n",
+      "# above the boxes around it; the daemon lifts it higher when the pile\n",
+      "# is, and checks the move to the place pallet against the pile) and comes\n",
+      "# down onto its slot from as high, so it never sweeps through the layer\n",
+      "# it joins.\n",
       "waypoints {\n  approach_distance_m: 0.10\n  retrieve_height_m: ", Num(cell.lift_height_m),
       "\n  place_approach_height_m: ", Num(cell.lift_height_m), "\n}\n\n",
       "# Every box has a slot on the place pallet: far row first, then towards\n# the robot.\n",

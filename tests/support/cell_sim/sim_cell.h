@@ -75,10 +75,11 @@ struct SimCell {
   int place_rows = 1, place_columns = 1, place_layers = 1;
   double place_spacing_x_m = 0.0, place_spacing_y_m = 0.0, place_layer_height_m = 0.0;
   // How high the held box is lifted above its grasp and lowered from onto
-  // its slot, m: its bottom clears the boxes around it by 0.2 m (a pallet's
-  // box by its height, a heap's by its longest side), enough for the dip of
-  // the joint move to the place pallet, which starts over the pile.
-  double lift_height_m = 0.35;
+  // its slot at least, m: its bottom clears the boxes around it by 5 cm (a
+  // pallet's box by its height, a heap's by its longest side). The daemon
+  // raises it to clear the pile's top and checks the joint move to the
+  // place pallet against the pile (a transit when it would dip).
+  double lift_height_m = 0.20;
 };
 
 // Builds the cell and its load; the same options give the same cell.
