@@ -105,6 +105,8 @@ void CellController::Record(PickRecord record) {
     if (record.outcome == PickOutcome::kCompleted || record.outcome == PickOutcome::kDryRun) {
       ++status_.picks_done;
       ++status_.next_slot;
+      picked_depths_.push_back(record.plan.box.depth_m);
+      if (picked_depths_.size() > 100) picked_depths_.erase(picked_depths_.begin());
     } else {
       ++status_.picks_failed;
     }
@@ -346,9 +348,14 @@ std::optional<CellController::PreparedPick> CellController::PreparePick(const Fr
                           dims.l, " x ", dims.b, " x ", dims.h, " m"));
     return std::nullopt;
   }
+  std::vector<double> picked_depths;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    picked_depths = picked_depths_;
+  }
   const PickSelection selection =
       SelectPick(frame.boxes, options_.base_T_camera, dims, options_.selection, options_.workspace,
-                 options_.waypoints, reachable_);
+                 options_.waypoints, reachable_, picked_depths);
   if (!selection.chosen) {
     Note(absl::StrCat(frame_name, ": ", DescribeRejections(selection)));
     return std::nullopt;

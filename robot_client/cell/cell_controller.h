@@ -135,6 +135,9 @@ class CellController {
   std::string latched_fault_;  // guarded by mutex_
   // The slot of the pick whose end is unknown (status_.unknown_pick_id).
   int unknown_pick_slot_ = -1;  // guarded by mutex_
+  // Grasp depths of the completed picks, oldest first, at most 100: the
+  // face check's history (SelectionOptions::face_check_history).
+  std::vector<double> picked_depths_;  // guarded by mutex_
   CellStatusSnapshot status_;       // guarded by mutex_
   std::deque<PickRecord> records_;  // guarded by mutex_
 

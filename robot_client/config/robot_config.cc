@@ -75,6 +75,10 @@ absl::Status SelectionOptions::Validate() const {
     return Invalid(absl::StrCat("selection.min_layer_for_face_check is ", min_layer_for_face_check,
                                 "; must be in [0, 1000]"));
   }
+  if (face_check_history < 0 || face_check_history > 100) {
+    return Invalid(absl::StrCat("selection.face_check_history is ", face_check_history,
+                                "; must be in [0, 100]"));
+  }
   return absl::OkStatus();
 }
 

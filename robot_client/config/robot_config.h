@@ -107,6 +107,13 @@ struct SelectionOptions {
   // have) is declined: the detector took the wrong face size, so the box's
   // bottom, and where it is put down, would be wrong. 0 = no such check.
   int min_layer_for_face_check = 3;
+  // The grasp depths of this many of the last completed picks vote in the
+  // face check beside the boxes in view, [0, 100]; 0 = the frame alone. A
+  // pallet holds one box lying one way: with its history the cell still
+  // tells a wrong face from the right one when only the last box or two of
+  // a layer are in view. Leave 0 for heaps and bins, whose boxes lie every
+  // way.
+  int face_check_history = 0;
 
   absl::Status Validate() const;
 };

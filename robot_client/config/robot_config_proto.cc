@@ -98,6 +98,9 @@ void SelectionFromProto(const v1::SelectionConfig& selection, SelectionOptions* 
   }
   if (selection.has_min_score()) options->min_score = selection.min_score();
   if (selection.has_height_tie_m()) options->height_tie_m = selection.height_tie_m();
+  if (selection.has_face_check_history()) {
+    options->face_check_history = selection.face_check_history();
+  }
 }
 
 absl::Status GripperFromProto(const v1::GripperConfig& gripper, GripperOptions* g) {

@@ -104,7 +104,8 @@ double OverlapDepth(const Footprint& a, const Footprint& b) {
 // its layer show (a wrong face size: its depth, and so its bottom, is off).
 std::string CheckAgainstPile(size_t i, const std::vector<BoxVerdict>& verdicts,
                              const std::vector<Footprint>& footprints,
-                             const SelectionOptions& selection) {
+                             const SelectionOptions& selection,
+                             const std::vector<double>& recent_depths) {
   const Footprint& f = footprints[i];
   std::vector<size_t> layer;
   for (size_t j = 0; j < footprints.size(); ++j) {
@@ -121,31 +122,38 @@ std::string CheckAgainstPile(size_t i, const std::vector<BoxVerdict>& verdicts,
   }
   // The face check looks at the whole frame: the visible boxes of a pallet
   // (its top layer and the exposed edges of the ones below) lie alike.
-  if (selection.min_layer_for_face_check > 0 &&
-      static_cast<int>(verdicts.size()) >= selection.min_layer_for_face_check) {
+  // The boxes in view and the last picks' grasp depths vote.
+  std::vector<double> depths;
+  for (const BoxVerdict& v : verdicts) depths.push_back(v.box.depth_m);
+  const size_t history = std::min(recent_depths.size(),
+                                  static_cast<size_t>(std::max(0, selection.face_check_history)));
+  depths.insert(depths.end(), recent_depths.end() - history, recent_depths.end());
+  const int votes = static_cast<int>(depths.size());
+  if (selection.min_layer_for_face_check > 0 && votes >= selection.min_layer_for_face_check) {
     const double depth_i = verdicts[i].box.depth_m;
     int agree = 0;
     int best_agree = 0;
     double best_depth = depth_i;
-    for (size_t j = 0; j < verdicts.size(); ++j) {
+    for (size_t j = 0; j < depths.size(); ++j) {
       int n = 0;
-      for (const BoxVerdict& other : verdicts) {
-        if (std::abs(other.box.depth_m - verdicts[j].box.depth_m) <= selection.layer_tolerance_m) {
-          ++n;
-        }
-      }
+      for (double other : depths) n += std::abs(other - depths[j]) <= selection.layer_tolerance_m;
       if (j == i) agree = n;
       if (n > best_agree) {
         best_agree = n;
-        best_depth = verdicts[j].box.depth_m;
+        best_depth = depths[j];
       }
     }
     // Declined only when a clear majority shows another face.
-    if (3 * best_agree >= 2 * static_cast<int>(verdicts.size()) && agree < best_agree &&
+    if (3 * best_agree >= 2 * votes && agree < best_agree &&
         std::abs(best_depth - depth_i) > selection.layer_tolerance_m) {
-      return absl::StrFormat("grasp face is %.3f m deep, but %d of the %d boxes in view show a "
-                             "face %.3f m deep: the wrong face size",
-                             depth_i, best_agree, static_cast<int>(verdicts.size()), best_depth);
+      const int in_view = static_cast<int>(verdicts.size());
+      return absl::StrFormat(
+          "grasp face is %.3f m deep, but %d of the %d boxes in view%s show a face %.3f m deep: "
+          "the wrong face size",
+          depth_i, best_agree, votes,
+          history > 0 ? absl::StrFormat(" (%d) and last picks (%d)", in_view, votes - in_view)
+                      : std::string(),
+          best_depth);
     }
   }
   return "";
@@ -156,7 +164,8 @@ std::string CheckAgainstPile(size_t i, const std::vector<BoxVerdict>& verdicts,
 PickSelection SelectPick(const std::vector<DetectedBox>& boxes,
                          const Eigen::Isometry3d& base_T_camera, const BoxDims& dims,
                          const SelectionOptions& selection, const Workspace& workspace,
-                         const WaypointOptions& waypoints, const Reachability& reachable) {
+                         const WaypointOptions& waypoints, const Reachability& reachable,
+                         const std::vector<double>& recent_depths) {
   PickSelection result;
   result.verdicts.reserve(boxes.size());
   for (size_t i = 0; i < boxes.size(); ++i) {
@@ -201,7 +210,8 @@ PickSelection SelectPick(const std::vector<DetectedBox>& boxes,
     } else if (!(verdict.box.tilt_deg <= selection.max_grasp_tilt_deg)) {
       verdict.reason = absl::StrFormat("grasp face tilted %.1f deg from base +z (max %.1f)",
                                        verdict.box.tilt_deg, selection.max_grasp_tilt_deg);
-    } else if (std::string pile = CheckAgainstPile(i, result.verdicts, footprints, selection);
+    } else if (std::string pile =
+                   CheckAgainstPile(i, result.verdicts, footprints, selection, recent_depths);
                !pile.empty()) {
       verdict.reason = std::move(pile);
     } else {

@@ -42,10 +42,13 @@ struct PickSelection {
 // chooses the highest grasp point; grasp points within
 // selection.height_tie_m of the highest are ties, decided by the higher
 // score (then the higher point, then the lower index). `ranked` repeats
-// that choice on the boxes not yet ranked.
+// that choice on the boxes not yet ranked. `recent_depths` are the grasp
+// depths (BoxInBase::depth_m) of the cell's completed picks, oldest first:
+// the last selection.face_check_history of them vote in the face check.
 PickSelection SelectPick(const std::vector<DetectedBox>& boxes,
                          const Eigen::Isometry3d& base_T_camera, const BoxDims& dims,
                          const SelectionOptions& selection, const Workspace& workspace,
-                         const WaypointOptions& waypoints, const Reachability& reachable);
+                         const WaypointOptions& waypoints, const Reachability& reachable,
+                         const std::vector<double>& recent_depths = {});
 
 }  // namespace cornerpose::robot_client

@@ -201,6 +201,37 @@ TEST_F(PickSelectionTest, WrongFaceSizeInALayerIsDeclined) {
   EXPECT_EQ(Select(boxes).chosen, 3);
 }
 
+TEST_F(PickSelectionTest, TheLastPicksVoteOnTheFaceWhenFewBoxesAreInView) {
+  // The last box of a layer, taken on its side (+y up: 0.20 m deep), alone
+  // in view: the frame alone cannot tell; the cell's last picks, all 0.15 m
+  // deep, can.
+  DetectedBox side;
+  side.camera_T_box.translation() = Eigen::Vector3d(0.35, -0.25, 0.30 - 0.10);
+  side.camera_T_box.linear() =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  side.grasp_face = BoxFace::kPlusY;
+  side.score = 0.99;
+  const std::vector<double> picked(10, 0.15);
+  auto select = [&](const std::vector<double>& history) {
+    return SelectPick({side}, Eigen::Isometry3d::Identity(), kCarton, selection_, workspace_,
+                      waypoints_, nullptr, history);
+  };
+  // No history configured: chosen.
+  EXPECT_EQ(select(picked).chosen, 0);
+  selection_.face_check_history = 4;
+  const PickSelection s = select(picked);
+  EXPECT_FALSE(s.chosen.has_value());
+  EXPECT_THAT(s.verdicts[0].reason,
+              HasSubstr("4 of the 5 boxes in view (1) and last picks (4) show a face 0.150 m deep"));
+  // Picks of the same face agree with it.
+  EXPECT_EQ(select(std::vector<double>(10, 0.20)).chosen, 0);
+  // Too few votes for the check (min_layer_for_face_check 3): one pick.
+  EXPECT_EQ(select({0.15}).chosen, 0);
+  // Out of range is named.
+  selection_.face_check_history = 101;
+  EXPECT_THAT(selection_.Validate().message(), HasSubstr("selection.face_check_history"));
+}
+
 TEST_F(PickSelectionTest, ALayerOfThreeSharesItsMedianTop) {
   // Tops 0.300, 0.305 and 0.288 (the sensor's depth steps): each grasp point
   // at 0.300; a pair alone keeps its own.

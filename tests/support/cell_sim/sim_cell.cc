@@ -161,19 +161,32 @@ absl::StatusOr<SimCell> MakeSimCell(const SimCellOptions& cell, const SimLoadOpt
   SimCell out;
   CellLayout& layout = out.layout;
   layout.arm = cell.arm;
-  layout.world_T_base = At({0, cell.base_y_m, cell.pedestal_height_m});
+  // A cell stands its robot above the load it unloads: a pallet load
+  // higher than the pedestal raises the base plate to 5 cm above its top.
+  const double load_top = testing::kEurPalletHeight + load.layers * load.box.h;
+  const double pedestal =
+      load.kind == "pallet" ? std::max(cell.pedestal_height_m, load_top + 0.05)
+                            : cell.pedestal_height_m;
+  layout.world_T_base = At({0, cell.base_y_m, pedestal});
   layout.world_T_camera = testing::LookAtCamera(Eigen::Vector3d::Zero(), cell.camera_height_m,
                                                 /*tilt_deg=*/0, /*yaw_deg=*/0, /*roll_deg=*/0);
   layout.supports = testing::MakeEurPallet(Eigen::Isometry3d::Identity());
   const double place_y = 2 * cell.base_y_m;
-  for (auto& part : testing::MakeEurPallet(At({0, place_y, 0}))) {
+  // The place pallet stands on a stand as much higher as the robot is (an
+  // outfeed at the height the arm reaches, as the robot's own is).
+  const double place_stand = pedestal - cell.pedestal_height_m;
+  for (auto& part : testing::MakeEurPallet(At({0, place_y, place_stand}))) {
     part.name = "place_" + part.name;
     layout.supports.push_back(part);
   }
+  if (place_stand > 0.0) {
+    layout.supports.push_back(
+        {"place_stand", {1.2, 0.8, place_stand}, At({0, place_y, 0.5 * place_stand})});
+  }
   // The pedestal under the base plate (a UR5e's is 149 mm across).
   layout.supports.push_back({"pedestal",
-                             {0.18, 0.18, cell.pedestal_height_m},
-                             At({0, cell.base_y_m, 0.5 * cell.pedestal_height_m})});
+                             {0.18, 0.18, pedestal},
+                             At({0, cell.base_y_m, 0.5 * pedestal})});
   layout.pick_area = {Eigen::Vector3d(-0.7, -0.47, 0.0), Eigen::Vector3d(0.7, 0.47, 3.0)};
   layout.place_area = {Eigen::Vector3d(-0.7, place_y - 0.42, 0.0),
                        Eigen::Vector3d(0.7, place_y + 0.42, 3.0)};
@@ -217,9 +230,10 @@ absl::StatusOr<SimCell> MakeSimCell(const SimCellOptions& cell, const SimLoadOpt
   out.place_layer_height_m = d.h;
   const Eigen::Vector3d origin_world(-0.5 * (out.place_columns - 1) * px,
                                      place_y - 0.5 * (out.place_rows - 1) * py,
-                                     testing::kEurPalletHeight);
+                                     place_stand + testing::kEurPalletHeight);
   out.place_origin_base = layout.world_T_base.inverse() * origin_world;
   out.lift_height_m = (load.kind == "pallet" ? d.h : d.vec().maxCoeff()) + 0.05;
+  out.face_check_history = load.kind == "pallet" ? 12 : 0;
   return out;
 }
 
@@ -263,7 +277,13 @@ absl::StatusOr<std::string> RobotClientConfigText(const SimCell& cell, const std
       "# Both pallets and the space above them, never lower than 3 cm above the floor.\n",
       "workspace {\n  min { x: -0.75 y: -1.0 z: ", Num(floor_z + 0.03),
       " }\n  max { x: 0.75 y: 1.0 z: 0.8 }\n}\n\n",
-      "selection {\n  max_grasp_tilt_deg: 30\n  min_score: 0.0\n  height_tie_m: 0.01\n}\n\n",
+      "selection {\n  max_grasp_tilt_deg: 30\n  min_score: 0.0\n  height_tie_m: 0.01\n",
+      cell.face_check_history > 0
+          ? absl::StrCat("  # A pallet holds one box lying one way: the last picks vote on\n",
+                         "  # which face the pile shows.\n  face_check_history: ",
+                         cell.face_check_history, "\n")
+          : std::string(),
+      "}\n\n",
       "gripper {\n  tcp_offset {\n    position { x: 0 y: 0 z: 0.10 }\n",
       "    rotation_vector { x: 0 y: 0 z: 0 }\n  }\n  suction_output: SUCTION_OUTPUT_KIND_TOOL\n",
       "  suction_output_index: 0\n  grasp_settle_s: 0.3\n  release_s: 0.3\n}\n\n",

@@ -25,9 +25,11 @@ namespace cornerpose::cell_sim {
 struct SimCellOptions {
   ur::ArmModel arm = ur::ArmModel::kUr5e;
   // Height of the base plate above the floor, m, [0.3, 1.5]. At 0.65 every
-  // grasp of a three-layer carton pallet (grasp faces 0.29-0.59 m above the
-  // floor, 0.36-0.06 m below the base) and its straight lift of 0.35 m stay
-  // inside the UR5e's singularity-free reach out to 0.85 m.
+  // grasp of a three-layer carton_s pallet (grasp faces 0.29-0.59 m above
+  // the floor, 0.36-0.06 m below the base) and its lift stay inside the
+  // UR5e's singularity-free reach out to 0.85 m. A pallet load whose top is
+  // higher raises it to 5 cm above that top (a cell stands its robot above
+  // the load it unloads): three layers of carton_l, 0.89 m, put it at 0.94.
   double pedestal_height_m = 0.65;
   // World y of the base axis, m (the pick pallet's centre is y = 0), [-1, -0.45].
   double base_y_m = -0.49;
@@ -80,6 +82,9 @@ struct SimCell {
   // raises it to clear the pile's top and checks the joint move to the
   // place pallet against the pile (a transit when it would dip).
   double lift_height_m = 0.20;
+  // The daemon's selection.face_check_history: 12 for a pallet (one box
+  // lying one way), 0 for heaps and bins.
+  int face_check_history = 0;
 };
 
 // Builds the cell and its load; the same options give the same cell.
