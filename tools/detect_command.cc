@@ -61,6 +61,9 @@ constexpr char kHelp[] =
     "                       of its tiles (true)\n"
     "  --floor_check BOOL   no box reaches through the floor, the farthest large plane\n"
     "                       (true)\n"
+    "  --tile_uncued BOOL   a face that runs on flat with no seam anywhere is a tile of\n"
+    "                       its layer when the layer tiles (false: a laptop lid is not\n"
+    "                       boxes; true for cells that see only layers of known boxes)\n"
     "  --size_tolerance M   how far a box may be off its nominal size and still be it\n"
     "                       (unset: each stage's own tolerance, 1-2.5 cm)\n"
     "  --kdtree             unorganized clouds: score edges over a k-d tree (the\n"
@@ -94,7 +97,8 @@ absl::Status Run(const CommandArgs& args) {
                          args.SetBool("denoise", &options.edge_points.denoise),
                          args.SetBool("faces", &options.face_proposals),
                          args.SetBool("layer_check", &options.faces.check_layer_tiling),
-                         args.SetBool("floor_check", &options.floor_check)}) {
+                         args.SetBool("floor_check", &options.floor_check),
+                         args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides)}) {
     if (!s.ok()) return s;
   }
   if (get("size_tolerance")) {
@@ -183,6 +187,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "faces",
                                                        "layer_check",
                                                        "floor_check",
+                                                       "tile_uncued",
                                                        "size_tolerance"},
                                                       {"quiet", "kdtree"});
   if (!args.ok()) {

@@ -8,6 +8,9 @@ void ApplyDetectorOverrides(const v1::DetectorOverrides& overrides, DetectorOpti
   if (overrides.has_ransac_threshold_m()) {
     options->segments.ransac_threshold_m = overrides.ransac_threshold_m();
   }
+  if (overrides.has_tile_uncued_sides()) {
+    options->refinement.tile_uncued_sides = overrides.tile_uncued_sides();
+  }
 }
 
 }  // namespace cornerpose::wire

@@ -157,6 +157,21 @@ TEST(ServerConfigTest, BadValuesAreInvalidArgument) {
   }
 }
 
+TEST(ServerConfigTest, TheSimulatedPalletCellTilesFacesWithNoSeam) {
+  const fs::path file =
+      fs::path(CORNERPOSE_SOURCE_DIR) / "deploy/config/sim_server_pallet.textproto";
+  absl::StatusOr<ServerOptions> options = LoadServerConfig(file.string());
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_TRUE(options->detector.refinement.tile_uncued_sides);
+  ASSERT_EQ(options->sources.size(), 1u);
+  EXPECT_EQ(options->sources[0].name, "sim");
+  // The heap and bin cell's keeps the default.
+  options = LoadServerConfig(
+      (fs::path(CORNERPOSE_SOURCE_DIR) / "deploy/config/sim_server.textproto").string());
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_FALSE(options->detector.refinement.tile_uncued_sides);
+}
+
 TEST(ServerConfigTest, BoxModelsAndDetectorDefaultsReachTheOptions) {
   const std::string path =
       WriteConfig("models.textproto",
@@ -171,6 +186,7 @@ TEST(ServerConfigTest, BoxModelsAndDetectorDefaultsReachTheOptions) {
   // Untouched parameters keep the detector's defaults.
   EXPECT_EQ(options->detector.segments.ransac_threshold_m,
             DetectorOptions{}.segments.ransac_threshold_m);
+  EXPECT_FALSE(options->detector.refinement.tile_uncued_sides);
 
   const absl::StatusOr<ServerOptions> bad = LoadServerConfig(
       WriteConfig("bad_defaults.textproto", "detector_defaults { edge_radius_m: -1 }\n"));
