@@ -217,7 +217,7 @@ void Controller::SubmitScript(const std::string& text) {
     ++programs_finished_;
   }
   pending_ = Pending{text, std::move(parsed.program)};
-  if (program_running_) abort_ = Abort::kReplaced;
+  if (program_running_ && abort_ != Abort::kProtectiveStop) abort_ = Abort::kReplaced;
   changed_.notify_all();
 }
 
@@ -237,7 +237,7 @@ bool Controller::PowerOff() {
   robot_mode_ = kRobotModePowerOff;
   mode_change_.reset();
   brake_release_requested_ = false;
-  if (program_running_) abort_ = Abort::kPowerOff;
+  if (program_running_ && abort_ != Abort::kProtectiveStop) abort_ = Abort::kPowerOff;
   pending_.reset();
   changed_.notify_all();
   return true;
@@ -276,7 +276,8 @@ bool Controller::UnlockProtectiveStop() {
 bool Controller::StopProgram() {
   std::lock_guard<std::mutex> lock(mutex_);
   const bool any = program_running_ || pending_.has_value();
-  if (program_running_) abort_ = Abort::kStopped;
+  // A program already halted by a protective stop stays on record as one.
+  if (program_running_ && abort_ != Abort::kProtectiveStop) abort_ = Abort::kStopped;
   pending_.reset();
   changed_.notify_all();
   return any;
@@ -313,7 +314,8 @@ void Controller::TriggerEmergencyStop() {
   mode_change_.reset();
   brake_release_requested_ = false;
   tool_outputs_ = 0;
-  if (program_running_) abort_ = Abort::kStopped;
+  // A program already halted by a protective stop stays on record as one.
+  if (program_running_ && abort_ != Abort::kProtectiveStop) abort_ = Abort::kStopped;
   pending_.reset();
   qd_ = {};
   q_target_ = q_;
