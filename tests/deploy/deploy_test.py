@@ -463,8 +463,13 @@ class KubernetesTest(DeployTestCase):
         policy = self.docs[("NetworkPolicy", "cornerpose-perception")]
         self.assertEqual(policy["spec"]["podSelector"]["matchLabels"],
                          self.deployment["spec"]["selector"]["matchLabels"])
-        ports = [p["port"] for rule in policy["spec"]["ingress"] for p in rule["ports"]]
-        self.assertEqual(ports, [self.ports.server])
+        ports = [[p["port"] for p in rule["ports"]] for rule in policy["spec"]["ingress"]]
+        http = next(p["containerPort"] for p in self.container["ports"] if p["name"] == "http")
+        # gRPC from the clients; the web view and /metrics from them and a scraper.
+        self.assertEqual(ports, [[self.ports.server], [http]])
+        scraper = policy["spec"]["ingress"][1]["from"]
+        self.assertIn({"cornerpose.io/metrics-scraper": "true"},
+                      [peer.get("podSelector", {}).get("matchLabels") for peer in scraper])
 
     def test_user_matches_image(self):
         users = [l.split()[1] for l in read("docker", "Dockerfile").splitlines()
