@@ -66,11 +66,11 @@ std::vector<testing::SceneBox> PalletLoad(const SimCellOptions& cell, const SimL
 }
 
 // A heap from the scene generator, moved onto the pallet deck (or the bin's
-// floor at deck_z); the first layout (of a few seeds) that fits the area.
+// floor at deck_z); the first layout (of up to 500 seeds) that fits the area.
 absl::StatusOr<std::vector<testing::SceneBox>> HeapLoad(const SimCellOptions& cell,
                                                         const SimLoadOptions& load, double deck_z,
                                                         double margin_m) {
-  for (uint32_t attempt = 0; attempt < 50; ++attempt) {
+  for (uint32_t attempt = 0; attempt < 500; ++attempt) {
     const testing::Scene heap =
         testing::MakeHeapScene(load.box, load.heap_boxes, load.seed + 7919u * attempt);
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
@@ -91,7 +91,8 @@ absl::StatusOr<std::vector<testing::SceneBox>> HeapLoad(const SimCellOptions& ce
     return boxes;
   }
   return absl::InvalidArgumentError(
-      absl::StrCat("no heap of ", load.heap_boxes, " boxes of this size fits the pick area"));
+      absl::StrCat("no heap of ", load.heap_boxes,
+                   " boxes of this size fits the pick area (in 500 layouts); try fewer boxes"));
 }
 
 // A bin standing on the pallet deck: a floor and four walls around the area.

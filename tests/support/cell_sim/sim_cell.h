@@ -60,7 +60,7 @@ struct SimLoadOptions {
   // jittered by up to +-1 mm and +-0.3 degrees.
   double gap_m = 0.003;
   // Heap and bin: how many boxes, [1, 60].
-  int heap_boxes = 12;
+  int heap_boxes = 8;
   uint32_t seed = 1;
 
   absl::Status Validate() const;
