@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "robot_client/cell/cell_steps.h"
 #include "robot_client/planning/grasp_geometry.h"
@@ -106,6 +107,9 @@ void CellController::Record(PickRecord record) {
       ++status_.picks_done;
       ++status_.next_slot;
       picked_depths_.push_back(record.plan.box.depth_m);
+      if (record.outcome == PickOutcome::kCompleted && record.source_live) {
+        last_completed_grasp_ = record.plan.box.grasp_point;
+      }
       if (picked_depths_.size() > 100) picked_depths_.erase(picked_depths_.begin());
     } else {
       ++status_.picks_failed;
@@ -353,9 +357,29 @@ std::optional<CellController::PreparedPick> CellController::PreparePick(const Fr
     std::lock_guard<std::mutex> lock(mutex_);
     picked_depths = picked_depths_;
   }
-  const PickSelection selection =
+  PickSelection selection =
       SelectPick(frame.boxes, options_.base_T_camera, dims, options_.selection, options_.workspace,
                  options_.waypoints, reachable_, picked_depths);
+  // Did the last pick take its box? A box still at its grasp point was not
+  // lifted: its slot is used again, and the box is declined until a pick
+  // changes the scene.
+  constexpr double kSamePlaceM = 0.02;
+  if (last_completed_grasp_) {
+    if (StillThere(selection, *last_completed_grasp_, kSamePlaceM)) {
+      not_lifted_.push_back({*last_completed_grasp_});
+      Note(absl::StrFormat("%s: the last pick left its box at (%.3f, %.3f, %.3f): slot %d is "
+                           "used again",
+                           frame_name, last_completed_grasp_->x(), last_completed_grasp_->y(),
+                           last_completed_grasp_->z(), slot - 1));
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (status_.next_slot > 0) --status_.next_slot;
+      slot = status_.next_slot;
+    } else {
+      not_lifted_.clear();
+    }
+    last_completed_grasp_.reset();
+  }
+  DeclineNotLifted(not_lifted_, kSamePlaceM, &selection);
   if (!selection.chosen) {
     Note(absl::StrCat(frame_name, ": ", DescribeRejections(selection)));
     return std::nullopt;
@@ -381,6 +405,7 @@ std::optional<CellController::PreparedPick> CellController::PreparePick(const Fr
   record.pick_id = next_pick_id_;
   record.program_name = PickProgramName(static_cast<int>(next_pick_id_));
   record.source = frame.source;
+  record.source_live = frame.source_live;
   record.frame_id = frame.frame_id;
   record.capture_time = frame.capture_time;
   record.score = planned.chosen->score;

@@ -24,6 +24,7 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "robot_client/cell/cell_state.h"
+#include "robot_client/cell/cell_steps.h"
 #include "robot_client/cell/perception_subscriber.h"
 #include "robot_client/cell/robot_link.h"
 #include "robot_client/config/robot_config.h"
@@ -138,6 +139,11 @@ class CellController {
   // Grasp depths of the completed picks, oldest first, at most 100: the
   // face check's history (SelectionOptions::face_check_history).
   std::vector<double> picked_depths_;  // guarded by mutex_
+  // The grasp point of the last completed pick from a live camera, until
+  // the next frame says whether its box left; the picks that left theirs
+  // (declined until a pick takes its box). The loop's thread only.
+  std::optional<Eigen::Vector3d> last_completed_grasp_;
+  std::vector<NotLifted> not_lifted_;
   CellStatusSnapshot status_;       // guarded by mutex_
   std::deque<PickRecord> records_;  // guarded by mutex_
 

@@ -52,6 +52,8 @@ struct PickRecord {
   std::string program_name;
   // The frame the box was detected in.
   std::string source;
+  // Whether that source is a live camera (not a replay of recorded frames).
+  bool source_live = false;
   uint64_t frame_id = 0;
   absl::Time capture_time;
   double score = 0.0;

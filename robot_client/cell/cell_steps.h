@@ -25,6 +25,23 @@ std::optional<std::string> FinishedReason(const CellStatusSnapshot& status, int 
 // detected" for none).
 std::string DescribeRejections(const PickSelection& selection);
 
+// Picks that did not lift their box. `grasp_point` is where the cup went
+// (base frame); a box whose grasp point is within `tolerance_m` of it in the
+// first frame after the pick is still there: nothing was lifted (something
+// lies on it, or the cup did not seal).
+struct NotLifted {
+  Eigen::Vector3d grasp_point = Eigen::Vector3d::Zero();
+};
+// True when a box of `selection` has its grasp point within tolerance_m of
+// `grasp_point`: the pick there left its box.
+bool StillThere(const PickSelection& selection, const Eigen::Vector3d& grasp_point,
+                double tolerance_m);
+// Declines every accepted box within tolerance_m of a not-lifted pick
+// ("a pick at (x, y, z) left this box where it was: something lies on it,
+// or the cup did not seal"), taking it out of ranked and chosen.
+void DeclineNotLifted(const std::vector<NotLifted>& not_lifted, double tolerance_m,
+                      PickSelection* selection);
+
 // The first of selection.ranked whose plan succeeds, and its plan; or, when
 // none does, every refusal ("#2 straight move ...").
 struct PlannedPick {

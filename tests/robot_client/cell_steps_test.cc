@@ -82,5 +82,29 @@ TEST(DescribeRejectionsTest, NamesEveryBox) {
       HasSubstr("2 boxes, none pickable: #0 score 0.1 below 0.5; #1 outside the workspace"));
 }
 
+TEST(NotLiftedTest, ABoxLeftWhereItWasIsDeclinedAndTheRankingMovesOn) {
+  PickSelection selection = ThreeAccepted();  // grasp points x = 0, 0.1, 0.2; ranked 2, 0, 1
+  // The last pick went to box 2's grasp point, 1 cm off: its box is there.
+  EXPECT_TRUE(StillThere(selection, Eigen::Vector3d(0.21, 0, 0), 0.02));
+  EXPECT_FALSE(StillThere(selection, Eigen::Vector3d(0.25, 0, 0), 0.02));
+  DeclineNotLifted({{Eigen::Vector3d(0.21, 0, 0)}}, 0.02, &selection);
+  EXPECT_FALSE(selection.verdicts[2].accepted);
+  EXPECT_THAT(selection.verdicts[2].reason, HasSubstr("left this box where it was"));
+  EXPECT_EQ(selection.ranked, (std::vector<int>{0, 1}));
+  EXPECT_EQ(selection.chosen, 0);
+  // Nothing not lifted: nothing changes.
+  PickSelection untouched = ThreeAccepted();
+  DeclineNotLifted({}, 0.02, &untouched);
+  EXPECT_EQ(untouched.chosen, 2);
+  EXPECT_EQ(untouched.ranked.size(), 3u);
+  // All declined: no choice.
+  PickSelection none = ThreeAccepted();
+  DeclineNotLifted({{Eigen::Vector3d(0, 0, 0)}, {Eigen::Vector3d(0.1, 0, 0)},
+                    {Eigen::Vector3d(0.2, 0, 0)}},
+                   0.02, &none);
+  EXPECT_FALSE(none.chosen.has_value());
+  EXPECT_TRUE(none.ranked.empty());
+}
+
 }  // namespace
 }  // namespace cornerpose::robot_client
