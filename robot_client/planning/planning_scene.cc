@@ -5,6 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "common/validation/range_check.h"
 #include "robot_client/planning/place_pattern.h"
 
 namespace cornerpose::robot_client {
@@ -25,21 +26,11 @@ collision::Obb BlockBetween(const Eigen::Vector3d& min, const Eigen::Vector3d& m
 }  // namespace
 
 absl::Status CollisionCheckOptions::Validate() const {
-  if (!(clearance_m >= 0.0 && clearance_m <= 0.2)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("clearance_m is %g, must be in [0, 0.2]", clearance_m));
-  }
-  if (!(max_step_rad > 0.0 && max_step_rad <= 0.2)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("max_step_rad is %g, must be in (0, 0.2]", max_step_rad));
-  }
-  if (!(tool.radius_m > 0.0 && tool.radius_m <= 0.2)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("tool.radius_m is %g, must be in (0, 0.2]", tool.radius_m));
-  }
-  if (!(tool.cup_compliance_m >= 0.0 && tool.cup_compliance_m <= 0.05)) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "tool.cup_compliance_m is %g, must be in [0, 0.05]", tool.cup_compliance_m));
+  for (absl::Status s : {CheckRange("clearance_m", clearance_m, 0.0, 0.2),
+                         CheckPositive("max_step_rad", max_step_rad, 0.2),
+                         CheckPositive("tool.radius_m", tool.radius_m, 0.2),
+                         CheckRange("tool.cup_compliance_m", tool.cup_compliance_m, 0.0, 0.05)}) {
+    if (!s.ok()) return s;
   }
   return absl::OkStatus();
 }
@@ -72,12 +63,25 @@ PlanningScene ScenePerPick(const std::vector<BoxInBase>& boxes, const BoxDims& d
   return scene;
 }
 
-void DropWhatTheArmOccupies(ur::ArmModel model, const Eigen::Isometry3d& flange_T_tcp,
-                            const ur::Joints& q, const CollisionCheckOptions& options,
-                            PlanningScene& scene) {
+namespace {
+
+// The arm's links at joints q, grown by the clearance.
+std::vector<collision::Capsule> InflatedLinks(ur::ArmModel model,
+                                              const Eigen::Isometry3d& flange_T_tcp,
+                                              const ur::Joints& q,
+                                              const CollisionCheckOptions& options) {
   std::vector<collision::Capsule> links =
       collision::ArmCapsules(model, q, flange_T_tcp, options.tool);
   for (collision::Capsule& link : links) link.radius += options.clearance_m;
+  return links;
+}
+
+}  // namespace
+
+void DropWhatTheArmOccupies(ur::ArmModel model, const Eigen::Isometry3d& flange_T_tcp,
+                            const ur::Joints& q, const CollisionCheckOptions& options,
+                            PlanningScene& scene) {
+  const std::vector<collision::Capsule> links = InflatedLinks(model, flange_T_tcp, q, options);
   std::erase_if(scene.obstacles, [&](const SceneObstacle& obstacle) {
     return std::any_of(links.begin(), links.end(), [&](const collision::Capsule& link) {
       return collision::CapsuleTouchesBox(link, obstacle.box);
@@ -92,9 +96,7 @@ namespace {
 std::string ContactAt(ur::ArmModel model, const Eigen::Isometry3d& flange_T_tcp,
                       const ur::Joints& q, const std::optional<HeldBox>& held,
                       const PlanningScene& scene, const CollisionCheckOptions& options) {
-  std::vector<collision::Capsule> links =
-      collision::ArmCapsules(model, q, flange_T_tcp, options.tool);
-  for (collision::Capsule& link : links) link.radius += options.clearance_m;
+  const std::vector<collision::Capsule> links = InflatedLinks(model, flange_T_tcp, q, options);
   std::optional<collision::Obb> carried;
   if (held) {
     const Eigen::Isometry3d base_T_tcp = TcpPoseFromJoints(model, q, flange_T_tcp);

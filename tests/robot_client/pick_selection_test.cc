@@ -24,6 +24,18 @@ DetectedBox Box(double x, double y, double top_z, double score) {
   return box;
 }
 
+// A carton the detector took on its side (+y up: 0.20 m deep), its top at
+// 0.30 m like Box(0.35, -0.25, 0.30, ...).
+DetectedBox OnItsSide() {
+  DetectedBox side;
+  side.camera_T_box.translation() = Eigen::Vector3d(0.35, -0.25, 0.30 - 0.10);
+  side.camera_T_box.linear() =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  side.grasp_face = BoxFace::kPlusY;
+  side.score = 0.99;
+  return side;
+}
+
 class PickSelectionTest : public ::testing::Test {
  protected:
   PickSelection Select(const std::vector<DetectedBox>& boxes,
@@ -183,12 +195,7 @@ TEST_F(PickSelectionTest, WrongFaceSizeInALayerIsDeclined) {
   // on its side (+y up: 0.20 m deep) with its top at the same height.
   std::vector<DetectedBox> boxes = {Box(0.0, -0.5, 0.30, 0.9), Box(0.35, -0.5, 0.30, 0.9),
                                     Box(0.0, -0.25, 0.30, 0.9)};
-  DetectedBox side;
-  side.camera_T_box.translation() = Eigen::Vector3d(0.35, -0.25, 0.30 - 0.10);
-  side.camera_T_box.linear() =
-      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  side.grasp_face = BoxFace::kPlusY;
-  side.score = 0.99;
+  const DetectedBox side = OnItsSide();
   boxes.push_back(side);
   const PickSelection s = Select(boxes);
   ASSERT_EQ(s.verdicts.size(), 4u);
@@ -205,12 +212,7 @@ TEST_F(PickSelectionTest, TheLastPicksVoteOnTheFaceWhenFewBoxesAreInView) {
   // The last box of a layer, taken on its side (+y up: 0.20 m deep), alone
   // in view: the frame alone cannot tell; the cell's last picks, all 0.15 m
   // deep, can.
-  DetectedBox side;
-  side.camera_T_box.translation() = Eigen::Vector3d(0.35, -0.25, 0.30 - 0.10);
-  side.camera_T_box.linear() =
-      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  side.grasp_face = BoxFace::kPlusY;
-  side.score = 0.99;
+  const DetectedBox side = OnItsSide();
   const std::vector<double> picked(10, 0.15);
   auto select = [&](const std::vector<double>& history) {
     return SelectPick({side}, Eigen::Isometry3d::Identity(), kCarton, selection_, workspace_,

@@ -9,8 +9,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <vector>
 
+#include "robot_client/config/robot_config.h"
 #include "robot_client/planning/pick_plan.h"
 #include "robot_client/planning/place_pattern.h"
 #include "robot_client/ur/kinematics.h"
@@ -23,9 +25,24 @@ using ::testing::Not;
 
 const BoxDims kCarton{0.30, 0.20, 0.15};
 
-// The simulated cell's geometry (deploy/config/sim_robot_client.textproto):
-// a UR5e between a pick pallet at +y and a place pallet at -y.
-constexpr ur::Joints kClear = {-1.5708, -1.5710, 1.5710, -1.5710, -1.5710, 0.0};
+// The simulated cell as the daemon is configured for it
+// (deploy/config/sim_robot_client.textproto): a UR5e between a pick pallet
+// at +y and a place pallet at -y, the place pattern, the workspace and the
+// clear pose.
+const RobotClientOptions& SimCell() {
+  static const RobotClientOptions options = [] {
+    absl::StatusOr<RobotClientOptions> loaded = LoadRobotClientConfig(
+        (std::filesystem::path(CORNERPOSE_SOURCE_DIR) / "deploy/config/sim_robot_client.textproto")
+            .string());
+    EXPECT_TRUE(loaded.ok()) << loaded.status();
+    return loaded.ok() ? *loaded : RobotClientOptions{};
+  }();
+  return options;
+}
+const ur::Joints& Clear() { return *SimCell().clear_joints; }
+double Floor() { return SimCell().workspace.min_m.z(); }
+ur::ArmModel Arm() { return SimCell().robot.arm_model; }
+const Eigen::Isometry3d& Tcp() { return SimCell().gripper.flange_T_tcp; }
 
 BoxInBase Carton(double x, double y, double top_z) {
   DetectedBox box;
@@ -44,50 +61,13 @@ std::vector<BoxInBase> TopLayer() {
   return boxes;
 }
 
-PlacePatternOptions DemoPattern() {
-  PlacePatternOptions p;
-  p.base_T_origin.translation() = Eigen::Vector3d(-0.465, -0.70, -0.506);
-  p.rows = 3;
-  p.columns = 4;
-  p.layers = 3;
-  p.spacing_x_m = 0.31;
-  p.spacing_y_m = 0.21;
-  p.layer_height_m = 0.15;
-  return p;
-}
-
-Workspace DemoWorkspace() {
-  Workspace w;
-  w.min_m = Eigen::Vector3d(-0.75, -1.0, -0.62);
-  w.max_m = Eigen::Vector3d(0.75, 1.0, 0.8);
-  return w;
-}
-
-PickArm DemoArm() {
-  PickArm arm;
-  arm.model = ur::ArmModel::kUr5e;
-  arm.flange_T_tcp.translation() = Eigen::Vector3d(0, 0, 0.10);
-  arm.joints = kClear;
-  arm.branch_reference = kClear;
-  arm.straight_moves.linear_speed_m_s = 0.25;
-  return arm;
-}
-
-WaypointOptions DemoWaypoints() {
-  WaypointOptions w;
-  w.approach_distance_m = 0.10;
-  w.retrieve_height_m = 0.35;
-  w.place_approach_height_m = 0.35;
-  return w;
-}
-
 TEST(PlanningSceneTest, ColumnsUnderDetectedBoxesAndBlocksOnFilledSlots) {
   const std::vector<BoxInBase> boxes = {Carton(0.1, 0.5, 0.2), Carton(-0.3, 0.5, 0.05)};
-  const PlanningScene scene = ScenePerPick(boxes, kCarton, DemoPattern(), 5, -0.6);
+  const PlanningScene scene = ScenePerPick(boxes, kCarton, SimCell().place_pattern, 5, Floor());
   ASSERT_EQ(scene.obstacles.size(), 2u + 5u);
   // A column from the floor to the box's top over its footprint.
   const collision::Aabb column = collision::BoundsOf(scene.obstacles[0].box);
-  EXPECT_NEAR(column.min.z(), -0.6, 1e-9);
+  EXPECT_NEAR(column.min.z(), Floor(), 1e-9);
   EXPECT_NEAR(column.max.z(), 0.2, 1e-9);
   EXPECT_NEAR(column.max.x() - column.min.x(), 0.30, 1e-9);
   EXPECT_NEAR(column.max.y() - column.min.y(), 0.20, 1e-9);
@@ -95,33 +75,34 @@ TEST(PlanningSceneTest, ColumnsUnderDetectedBoxesAndBlocksOnFilledSlots) {
   // Slot 4's cell: its pattern position, one layer tall, 5 mm in from the
   // cell's sides.
   const collision::Aabb cell = collision::BoundsOf(scene.obstacles[2 + 4].box);
-  const Eigen::Vector3d slot4 = SlotPose(DemoPattern(), 4)->translation();
+  const Eigen::Vector3d slot4 = SlotPose(SimCell().place_pattern, 4)->translation();
   EXPECT_NEAR(0.5 * (cell.min.x() + cell.max.x()), slot4.x(), 1e-9);
   EXPECT_NEAR(cell.min.z(), slot4.z(), 1e-9);
-  EXPECT_NEAR(cell.max.x() - cell.min.x(), 0.31 - 0.01, 1e-9);
+  EXPECT_NEAR(cell.max.x() - cell.min.x(), SimCell().place_pattern.spacing_x_m - 0.01, 1e-9);
   EXPECT_THAT(scene.obstacles[2 + 4].name, HasSubstr("slot 4"));
   // No slot filled, no box seen: nothing.
-  EXPECT_TRUE(ScenePerPick({}, kCarton, DemoPattern(), 0, -0.6).obstacles.empty());
+  EXPECT_TRUE(ScenePerPick({}, kCarton, SimCell().place_pattern, 0, Floor()).obstacles.empty());
 }
 
 TEST(PlanningSceneTest, AFreeMoveThroughABoxNamesTheLinkAndTheBox) {
-  const PickArm arm = DemoArm();
   // The tool swept from above the pallet's left to its right, 5 cm above
   // the tops, then through a box standing 0.3 m higher in between.
   const Eigen::Isometry3d down(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
   auto joints_at = [&](double x) {
     Eigen::Isometry3d tcp = down;
     tcp.translation() = Eigen::Vector3d(x, 0.49, -0.006);
-    return *ur::InverseKinematics(arm.model, tcp * arm.flange_T_tcp.inverse(), kClear);
+    return *ur::InverseKinematics(Arm(), tcp * Tcp().inverse(), Clear());
   };
   const ur::Joints from = joints_at(-0.3), to = joints_at(0.3);
-  PlanningScene scene = ScenePerPick(TopLayer(), kCarton, DemoPattern(), 0, -0.6);
-  EXPECT_TRUE(CheckFreeMove(arm.model, arm.flange_T_tcp, from, to, std::nullopt, scene,
+  PlanningScene scene = ScenePerPick(TopLayer(), kCarton, SimCell().place_pattern, 0, Floor());
+  EXPECT_TRUE(CheckFreeMove(Arm(), Tcp(), from, to, std::nullopt, scene,
                             CollisionCheckOptions{}, "test")
                   .ok());
-  scene.obstacles.push_back({"the tall box", collision::Obb{BoxDims{0.2, 0.2, 0.3}, {}}});
-  scene.obstacles.back().box.world_T_box.translation() = Eigen::Vector3d(0.0, 0.49, 0.0);
-  const absl::Status hit = CheckFreeMove(arm.model, arm.flange_T_tcp, from, to, std::nullopt,
+  collision::Obb tall;
+  tall.dims = BoxDims{0.2, 0.2, 0.3};
+  tall.world_T_box.translation() = Eigen::Vector3d(0.0, 0.49, 0.0);
+  scene.obstacles.push_back({"the tall box", tall});
+  const absl::Status hit = CheckFreeMove(Arm(), Tcp(), from, to, std::nullopt,
                                          scene, CollisionCheckOptions{}, "test");
   EXPECT_EQ(hit.code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(hit.message(), HasSubstr("free move test: the "));
@@ -130,7 +111,7 @@ TEST(PlanningSceneTest, AFreeMoveThroughABoxNamesTheLinkAndTheBox) {
   const HeldBox held{kCarton, Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.075))};
   scene.obstacles.pop_back();
   const absl::Status carried =
-      CheckFreeMove(arm.model, arm.flange_T_tcp, from, to, held, scene, CollisionCheckOptions{},
+      CheckFreeMove(Arm(), Tcp(), from, to, held, scene, CollisionCheckOptions{},
                     "R->place_above");
   EXPECT_THAT(carried.message(), HasSubstr("the held box comes within 0.020 m of detected box"));
 }
@@ -139,11 +120,9 @@ TEST(PlanningSceneTest, WhatTheArmStandsInIsDropped) {
   // A box-shaped pedestal top seen under the robot's base is the robot's.
   std::vector<BoxInBase> boxes = TopLayer();
   boxes.push_back(Carton(0.0, 0.0, 0.0));
-  PlanningScene scene = ScenePerPick(boxes, kCarton, DemoPattern(), 0, -0.6);
+  PlanningScene scene = ScenePerPick(boxes, kCarton, SimCell().place_pattern, 0, Floor());
   ASSERT_EQ(scene.obstacles.size(), 13u);
-  DropWhatTheArmOccupies(ur::ArmModel::kUr5e,
-                         Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.10)), kClear,
-                         CollisionCheckOptions{}, scene);
+  DropWhatTheArmOccupies(Arm(), Tcp(), Clear(), CollisionCheckOptions{}, scene);
   ASSERT_EQ(scene.obstacles.size(), 12u);
   for (const SceneObstacle& o : scene.obstacles) EXPECT_THAT(o.name, Not(HasSubstr("box 12")));
 }
@@ -152,24 +131,21 @@ TEST(PlanningSceneTest, ALowPlaceIsReachedThroughATransitClearOfThePile) {
   // The demo's 8th pick: the top layer's far-left middle carton to slot 7,
   // on the empty place pallet's first layer. The direct movej from R sinks
   // the held box into its neighbour on the way out.
-  const PickArm arm = DemoArm();
+  const CollisionCheckOptions checks;
   std::vector<BoxInBase> layer = TopLayer();
   const BoxInBase picked = layer[4];  // (-0.454, 0.490)
-  const PlanningScene scene = ScenePerPick(layer, kCarton, DemoPattern(), 7, -0.6);
-  const Eigen::Isometry3d slot = *SlotPose(DemoPattern(), 7);
+  const PlanningScene scene = ScenePerPick(layer, kCarton, SimCell().place_pattern, 7, Floor());
 
-  absl::StatusOr<PickPlan> unchecked =
-      PlanPick(arm, picked, kCarton, slot, 7, DemoWaypoints(), DemoWorkspace());
+  absl::StatusOr<PickPlan> unchecked = PlanPickForSlot(SimCell(), Clear(), picked, 7, kCarton);
   ASSERT_TRUE(unchecked.ok()) << unchecked.status();
   EXPECT_FALSE(unchecked->transit.has_value());
   const HeldBox held{kCarton, unchecked->tcp_T_box};
   const absl::Status direct =
-      CheckFreeMove(arm.model, arm.flange_T_tcp, unchecked->retrieve_joints,
-                    unchecked->place_above_joints, held, scene, arm.free_moves, "R->place_above");
+      CheckFreeMove(Arm(), Tcp(), unchecked->retrieve_joints, unchecked->place_above_joints, held,
+                    scene, checks, "R->place_above");
   EXPECT_EQ(direct.code(), absl::StatusCode::kFailedPrecondition) << "the direct move was clear";
 
-  absl::StatusOr<PickPlan> plan =
-      PlanPick(arm, picked, kCarton, slot, 7, DemoWaypoints(), DemoWorkspace(), &scene);
+  absl::StatusOr<PickPlan> plan = PlanPickForSlot(SimCell(), Clear(), picked, 7, kCarton, &scene);
   ASSERT_TRUE(plan.ok()) << plan.status();
   ASSERT_TRUE(plan->transit.has_value());
   // Above the slot, at R's height or higher.
@@ -178,13 +154,14 @@ TEST(PlanningSceneTest, ALowPlaceIsReachedThroughATransitClearOfThePile) {
   EXPECT_GE(plan->transit->translation().z(), plan->retrieve.translation().z() - 1e-9);
   for (const auto& [from, to] : {std::pair{plan->retrieve_joints, plan->transit_joints},
                                  std::pair{plan->transit_joints, plan->place_above_joints}}) {
-    EXPECT_TRUE(CheckFreeMove(arm.model, arm.flange_T_tcp, from, to,
-                              HeldBox{kCarton, plan->tcp_T_box}, scene, arm.free_moves, "leg")
-                    .ok());
+    EXPECT_TRUE(
+        CheckFreeMove(Arm(), Tcp(), from, to, HeldBox{kCarton, plan->tcp_T_box}, scene, checks,
+                      "leg")
+            .ok());
   }
   // The approach from the clear pose is clear too.
-  EXPECT_TRUE(CheckFreeMove(arm.model, arm.flange_T_tcp, plan->initial_joints,
-                            plan->approach_joints, std::nullopt, scene, arm.free_moves, "I->M")
+  EXPECT_TRUE(CheckFreeMove(Arm(), Tcp(), plan->initial_joints, plan->approach_joints,
+                            std::nullopt, scene, checks, "I->M")
                   .ok());
 }
 
