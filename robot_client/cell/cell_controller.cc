@@ -367,10 +367,11 @@ std::optional<CellController::PreparedPick> CellController::PreparePick(const Fr
   if (last_completed_grasp_) {
     if (StillThere(selection, *last_completed_grasp_, kSamePlaceM)) {
       not_lifted_.push_back({*last_completed_grasp_});
-      Note(absl::StrFormat("%s: the last pick left its box at (%.3f, %.3f, %.3f): slot %d is "
-                           "used again",
-                           frame_name, last_completed_grasp_->x(), last_completed_grasp_->y(),
-                           last_completed_grasp_->z(), slot - 1));
+      Note(
+          absl::StrFormat("%s: the last pick left its box at (%.3f, %.3f, %.3f): slot %d is "
+                          "used again",
+                          frame_name, last_completed_grasp_->x(), last_completed_grasp_->y(),
+                          last_completed_grasp_->z(), slot - 1));
       std::lock_guard<std::mutex> lock(mutex_);
       if (status_.next_slot > 0) --status_.next_slot;
       slot = status_.next_slot;

@@ -28,10 +28,9 @@ std::string DescribeRejections(const PickSelection& selection) {
 
 bool StillThere(const PickSelection& selection, const Eigen::Vector3d& grasp_point,
                 double tolerance_m) {
-  return std::any_of(selection.verdicts.begin(), selection.verdicts.end(),
-                     [&](const BoxVerdict& v) {
-                       return (v.box.grasp_point - grasp_point).norm() <= tolerance_m;
-                     });
+  return std::any_of(
+      selection.verdicts.begin(), selection.verdicts.end(),
+      [&](const BoxVerdict& v) { return (v.box.grasp_point - grasp_point).norm() <= tolerance_m; });
 }
 
 void DeclineNotLifted(const std::vector<NotLifted>& not_lifted, double tolerance_m,

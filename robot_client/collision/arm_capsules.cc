@@ -43,8 +43,8 @@ std::vector<Capsule> ArmCapsules(ur::ArmModel model, const ur::Joints& q,
   out.push_back({"base", Eigen::Vector3d(0, 0, s.base_r), origin(1), s.base_r});
   const Eigen::Vector3d shoulder_side = origin(1) + s.shoulder_offset * z_axis(1);
   out.push_back({"shoulder", origin(1), shoulder_side, s.shoulder_r});
-  out.push_back({"upper_arm", shoulder_side, origin(2) + s.shoulder_offset * z_axis(2),
-                 s.upper_arm_r});
+  out.push_back(
+      {"upper_arm", shoulder_side, origin(2) + s.shoulder_offset * z_axis(2), s.upper_arm_r});
   out.push_back({"forearm", origin(2) + s.forearm_offset * z_axis(2),
                  origin(3) + s.forearm_offset * z_axis(3), s.forearm_r});
   out.push_back({"wrist_1", origin(3) + s.forearm_offset * z_axis(3), origin(4), s.wrist_r});
@@ -55,8 +55,7 @@ std::vector<Capsule> ArmCapsules(ur::ArmModel model, const ur::Joints& q,
   const Eigen::Vector3d along = tip - origin(6);
   const double length = along.norm() - tool.cup_compliance_m - tool.radius_m;
   if (length > 1e-6) {
-    out.push_back(
-        {"tool", origin(6), origin(6) + along.normalized() * length, tool.radius_m});
+    out.push_back({"tool", origin(6), origin(6) + along.normalized() * length, tool.radius_m});
   }
   return out;
 }

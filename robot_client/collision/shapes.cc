@@ -54,8 +54,7 @@ bool BoxesTouch(const Obb& a, const Obb& b) {
   const fcl::Boxd b_shape(b.dims.l, b.dims.b, b.dims.h);
   fcl::CollisionRequestd request;
   fcl::CollisionResultd result;
-  fcl::collide(&a_shape, FclPose(a.world_T_box), &b_shape, FclPose(b.world_T_box), request,
-               result);
+  fcl::collide(&a_shape, FclPose(a.world_T_box), &b_shape, FclPose(b.world_T_box), request, result);
   return result.isCollision();
 }
 

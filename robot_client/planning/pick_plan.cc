@@ -221,20 +221,22 @@ constexpr std::array<double, 4> kTransitRaises = {0.0, 0.1, 0.2, 0.3};
 
 // R -> place_above clear of the scene: directly, or through T (see the
 // header). Sets place_above_joints, and transit when it takes one.
-absl::Status CarryClear(const PickArm& arm, const PlanningScene& scene,
-                        const Workspace& workspace, PickPlan& plan) {
+absl::Status CarryClear(const PickArm& arm, const PlanningScene& scene, const Workspace& workspace,
+                        PickPlan& plan) {
   const HeldBox held{plan.box_dims, plan.tcp_T_box};
-  absl::Status direct = CheckFreeMove(arm.model, arm.flange_T_tcp, plan.retrieve_joints,
-                                      plan.place_above_joints, held, scene, arm.free_moves,
-                                      "R->place_above");
+  absl::Status direct =
+      CheckFreeMove(arm.model, arm.flange_T_tcp, plan.retrieve_joints, plan.place_above_joints,
+                    held, scene, arm.free_moves, "R->place_above");
   if (direct.ok()) return direct;
-  const double base_z = std::max(plan.retrieve.translation().z(), plan.place_above.translation().z());
+  const double base_z =
+      std::max(plan.retrieve.translation().z(), plan.place_above.translation().z());
   for (double raise : kTransitRaises) {
     Eigen::Isometry3d transit = plan.place_above;
     transit.translation().z() = base_z + raise;
     if (!workspace.Contains(transit.translation())) break;
     ur::Joints transit_joints{}, place_above_joints{};
-    if (!FreeMove(arm, "T (transit)", transit, plan.retrieve_joints, &transit_joints).ok()) continue;
+    if (!FreeMove(arm, "T (transit)", transit, plan.retrieve_joints, &transit_joints).ok())
+      continue;
     if (!CheckFreeMove(arm.model, arm.flange_T_tcp, plan.retrieve_joints, transit_joints, held,
                        scene, arm.free_moves, "R->T")
              .ok()) {

@@ -41,9 +41,8 @@ PlanningScene ScenePerPick(const std::vector<BoxInBase>& boxes, const BoxDims& d
   for (size_t i = 0; i < boxes.size(); ++i) {
     collision::Aabb column = collision::BoundsOf(collision::Obb{dims, boxes[i].base_T_box});
     column.min.z() = std::min(floor_z_m, column.max.z());
-    scene.obstacles.push_back(
-        {absl::StrCat("detected box ", i, " (or what is under it)"),
-         BlockBetween(column.min, column.max)});
+    scene.obstacles.push_back({absl::StrCat("detected box ", i, " (or what is under it)"),
+                               BlockBetween(column.min, column.max)});
   }
   const double largest = dims.vec().maxCoeff();
   const double cell_x = pattern.columns > 1 ? pattern.spacing_x_m : largest;
@@ -52,9 +51,9 @@ PlanningScene ScenePerPick(const std::vector<BoxInBase>& boxes, const BoxDims& d
     absl::StatusOr<Eigen::Isometry3d> base_T_slot = SlotPose(pattern, s);
     if (!base_T_slot.ok()) break;
     collision::Obb cell;
-    cell.dims = BoxDims{std::max(cell_x - 2 * kCellShrinkM, 0.0),
-                        std::max(cell_y - 2 * kCellShrinkM, 0.0),
-                        std::max(pattern.layer_height_m - kCellShrinkM, 0.0)};
+    cell.dims =
+        BoxDims{std::max(cell_x - 2 * kCellShrinkM, 0.0), std::max(cell_y - 2 * kCellShrinkM, 0.0),
+                std::max(pattern.layer_height_m - kCellShrinkM, 0.0)};
     cell.world_T_box = *base_T_slot;
     cell.world_T_box.translation() +=
         base_T_slot->linear().col(2) * (0.5 * (pattern.layer_height_m - kCellShrinkM));
@@ -105,8 +104,8 @@ std::string ContactAt(ur::ArmModel model, const Eigen::Isometry3d& flange_T_tcp,
   }
   for (const SceneObstacle& obstacle : scene.obstacles) {
     if (carried && collision::BoxesTouch(*carried, obstacle.box)) {
-      return absl::StrCat("the held box comes within ", absl::StrFormat("%.3f", options.clearance_m),
-                          " m of ", obstacle.name);
+      return absl::StrCat("the held box comes within ",
+                          absl::StrFormat("%.3f", options.clearance_m), " m of ", obstacle.name);
     }
     for (const collision::Capsule& link : links) {
       if (collision::CapsuleTouchesBox(link, obstacle.box)) {
@@ -135,8 +134,8 @@ absl::Status CheckFreeMove(ur::ArmModel model, const Eigen::Isometry3d& flange_T
     const std::string contact = ContactAt(model, flange_T_tcp, q, held, scene, options);
     if (!contact.empty()) {
       const Eigen::Vector3d p = TcpPoseFromJoints(model, q, flange_T_tcp).translation();
-      return absl::FailedPreconditionError(absl::StrFormat(
-          "free move %s: %s at (%.3f, %.3f, %.3f)", what, contact, p.x(), p.y(), p.z()));
+      return absl::FailedPreconditionError(absl::StrFormat("free move %s: %s at (%.3f, %.3f, %.3f)",
+                                                           what, contact, p.x(), p.y(), p.z()));
     }
   }
   return absl::OkStatus();

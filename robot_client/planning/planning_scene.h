@@ -25,7 +25,7 @@
 namespace cornerpose::robot_client {
 
 struct SceneObstacle {
-  std::string name;  // "the pile", "placed box in slot 4"
+  std::string name;    // "the pile", "placed box in slot 4"
   collision::Obb box;  // base frame
 };
 

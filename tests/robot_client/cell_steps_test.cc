@@ -99,9 +99,9 @@ TEST(NotLiftedTest, ABoxLeftWhereItWasIsDeclinedAndTheRankingMovesOn) {
   EXPECT_EQ(untouched.ranked.size(), 3u);
   // All declined: no choice.
   PickSelection none = ThreeAccepted();
-  DeclineNotLifted({{Eigen::Vector3d(0, 0, 0)}, {Eigen::Vector3d(0.1, 0, 0)},
-                    {Eigen::Vector3d(0.2, 0, 0)}},
-                   0.02, &none);
+  DeclineNotLifted(
+      {{Eigen::Vector3d(0, 0, 0)}, {Eigen::Vector3d(0.1, 0, 0)}, {Eigen::Vector3d(0.2, 0, 0)}},
+      0.02, &none);
   EXPECT_FALSE(none.chosen.has_value());
   EXPECT_TRUE(none.ranked.empty());
 }

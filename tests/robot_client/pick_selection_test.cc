@@ -223,8 +223,9 @@ TEST_F(PickSelectionTest, TheLastPicksVoteOnTheFaceWhenFewBoxesAreInView) {
   selection_.face_check_history = 4;
   const PickSelection s = select(picked);
   EXPECT_FALSE(s.chosen.has_value());
-  EXPECT_THAT(s.verdicts[0].reason,
-              HasSubstr("4 of the 5 boxes in view (1) and last picks (4) show a face 0.150 m deep"));
+  EXPECT_THAT(
+      s.verdicts[0].reason,
+      HasSubstr("4 of the 5 boxes in view (1) and last picks (4) show a face 0.150 m deep"));
   // Picks of the same face agree with it.
   EXPECT_EQ(select(std::vector<double>(10, 0.20)).chosen, 0);
   // Too few votes for the check (min_layer_for_face_check 3): one pick.

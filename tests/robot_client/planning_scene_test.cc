@@ -95,15 +95,15 @@ TEST(PlanningSceneTest, AFreeMoveThroughABoxNamesTheLinkAndTheBox) {
   };
   const ur::Joints from = joints_at(-0.3), to = joints_at(0.3);
   PlanningScene scene = ScenePerPick(TopLayer(), kCarton, SimCell().place_pattern, 0, Floor());
-  EXPECT_TRUE(CheckFreeMove(Arm(), Tcp(), from, to, std::nullopt, scene,
-                            CollisionCheckOptions{}, "test")
-                  .ok());
+  EXPECT_TRUE(
+      CheckFreeMove(Arm(), Tcp(), from, to, std::nullopt, scene, CollisionCheckOptions{}, "test")
+          .ok());
   collision::Obb tall;
   tall.dims = BoxDims{0.2, 0.2, 0.3};
   tall.world_T_box.translation() = Eigen::Vector3d(0.0, 0.49, 0.0);
   scene.obstacles.push_back({"the tall box", tall});
-  const absl::Status hit = CheckFreeMove(Arm(), Tcp(), from, to, std::nullopt,
-                                         scene, CollisionCheckOptions{}, "test");
+  const absl::Status hit =
+      CheckFreeMove(Arm(), Tcp(), from, to, std::nullopt, scene, CollisionCheckOptions{}, "test");
   EXPECT_EQ(hit.code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(hit.message(), HasSubstr("free move test: the "));
   EXPECT_THAT(hit.message(), HasSubstr(" comes within 0.020 m of the tall box at ("));
@@ -111,8 +111,7 @@ TEST(PlanningSceneTest, AFreeMoveThroughABoxNamesTheLinkAndTheBox) {
   const HeldBox held{kCarton, Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.075))};
   scene.obstacles.pop_back();
   const absl::Status carried =
-      CheckFreeMove(Arm(), Tcp(), from, to, held, scene, CollisionCheckOptions{},
-                    "R->place_above");
+      CheckFreeMove(Arm(), Tcp(), from, to, held, scene, CollisionCheckOptions{}, "R->place_above");
   EXPECT_THAT(carried.message(), HasSubstr("the held box comes within 0.020 m of detected box"));
 }
 
@@ -154,14 +153,13 @@ TEST(PlanningSceneTest, ALowPlaceIsReachedThroughATransitClearOfThePile) {
   EXPECT_GE(plan->transit->translation().z(), plan->retrieve.translation().z() - 1e-9);
   for (const auto& [from, to] : {std::pair{plan->retrieve_joints, plan->transit_joints},
                                  std::pair{plan->transit_joints, plan->place_above_joints}}) {
-    EXPECT_TRUE(
-        CheckFreeMove(Arm(), Tcp(), from, to, HeldBox{kCarton, plan->tcp_T_box}, scene, checks,
-                      "leg")
-            .ok());
+    EXPECT_TRUE(CheckFreeMove(Arm(), Tcp(), from, to, HeldBox{kCarton, plan->tcp_T_box}, scene,
+                              checks, "leg")
+                    .ok());
   }
   // The approach from the clear pose is clear too.
-  EXPECT_TRUE(CheckFreeMove(Arm(), Tcp(), plan->initial_joints, plan->approach_joints,
-                            std::nullopt, scene, checks, "I->M")
+  EXPECT_TRUE(CheckFreeMove(Arm(), Tcp(), plan->initial_joints, plan->approach_joints, std::nullopt,
+                            scene, checks, "I->M")
                   .ok());
 }
 

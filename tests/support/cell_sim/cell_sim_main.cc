@@ -27,7 +27,9 @@ ABSL_FLAG(std::string, scene, "pallet", "The load: pallet, heap (on the pallet) 
 ABSL_FLAG(std::string, box, "carton_s", "Box model (carton_s, carton_l, ...) or L,B,H in metres.");
 ABSL_FLAG(int, layers, 3, "Pallet layers.");
 ABSL_FLAG(std::string, pattern, "grid", "Pallet layer pattern: grid or interlock.");
-ABSL_FLAG(int, heap_boxes, 8, "Boxes in a heap or bin (a heap of more than about 8 carton_s rarely fits the 1.25 x 0.8 m pick area).");
+ABSL_FLAG(int, heap_boxes, 8,
+          "Boxes in a heap or bin (a heap of more than about 8 carton_s rarely fits the 1.25 x 0.8 "
+          "m pick area).");
 ABSL_FLAG(double, gap, 0.003, "Gap between pallet boxes, metres.");
 ABSL_FLAG(uint32_t, seed, 1, "Layout and noise seed.");
 ABSL_FLAG(std::string, sensor, "kinect", "Depth sensor model: kinect or ideal.");

@@ -165,9 +165,8 @@ absl::StatusOr<SimCell> MakeSimCell(const SimCellOptions& cell, const SimLoadOpt
   // A cell stands its robot above the load it unloads: a pallet load
   // higher than the pedestal raises the base plate to 5 cm above its top.
   const double load_top = testing::kEurPalletHeight + load.layers * load.box.h;
-  const double pedestal =
-      load.kind == "pallet" ? std::max(cell.pedestal_height_m, load_top + 0.05)
-                            : cell.pedestal_height_m;
+  const double pedestal = load.kind == "pallet" ? std::max(cell.pedestal_height_m, load_top + 0.05)
+                                                : cell.pedestal_height_m;
   layout.world_T_base = At({0, cell.base_y_m, pedestal});
   layout.world_T_camera = testing::LookAtCamera(Eigen::Vector3d::Zero(), cell.camera_height_m,
                                                 /*tilt_deg=*/0, /*yaw_deg=*/0, /*roll_deg=*/0);
@@ -185,9 +184,8 @@ absl::StatusOr<SimCell> MakeSimCell(const SimCellOptions& cell, const SimLoadOpt
         {"place_stand", {1.2, 0.8, place_stand}, At({0, place_y, 0.5 * place_stand})});
   }
   // The pedestal under the base plate (a UR5e's is 149 mm across).
-  layout.supports.push_back({"pedestal",
-                             {0.18, 0.18, pedestal},
-                             At({0, cell.base_y_m, 0.5 * pedestal})});
+  layout.supports.push_back(
+      {"pedestal", {0.18, 0.18, pedestal}, At({0, cell.base_y_m, 0.5 * pedestal})});
   layout.pick_area = {Eigen::Vector3d(-0.7, -0.47, 0.0), Eigen::Vector3d(0.7, 0.47, 3.0)};
   layout.place_area = {Eigen::Vector3d(-0.7, place_y - 0.42, 0.0),
                        Eigen::Vector3d(0.7, place_y + 0.42, 3.0)};
@@ -284,15 +282,13 @@ absl::StatusOr<std::string> RobotClientConfigText(const SimCell& cell, const std
                          "  # which face the pile shows.\n  face_check_history: ",
                          cell.face_check_history, "\n")
           : std::string(),
-      "}\n\n",
-      "gripper {\n  tcp_offset {\n    position { x: 0 y: 0 z: 0.10 }\n",
+      "}\n\n", "gripper {\n  tcp_offset {\n    position { x: 0 y: 0 z: 0.10 }\n",
       "    rotation_vector { x: 0 y: 0 z: 0 }\n  }\n  suction_output: SUCTION_OUTPUT_KIND_TOOL\n",
       "  suction_output_index: 0\n  grasp_settle_s: 0.3\n  release_s: 0.3\n}\n\n",
       "# The held box rises at least this far above its grasp (its bottom 5 cm\n",
       "# above the boxes around it; the daemon lifts it higher when the pile\n",
       "# is, and checks the move to the place pallet against the pile) and comes\n",
-      "# down onto its slot from as high, so it never sweeps through the layer\n",
-      "# it joins.\n",
+      "# down onto its slot from as high, so it never sweeps through the layer\n", "# it joins.\n",
       "waypoints {\n  approach_distance_m: 0.10\n  retrieve_height_m: ", Num(cell.lift_height_m),
       "\n  place_approach_height_m: ", Num(cell.lift_height_m), "\n}\n\n",
       "# Every box has a slot on the place pallet: far row first, then towards\n# the robot.\n",
