@@ -18,6 +18,11 @@ struct EvidenceOptions {
   double depth_tolerance_per_m2 = 0.004;
   // At most this many pixels are tested per box (a regular subsample). Count.
   int max_samples = 3000;
+  // The first look at an unrefined hypothesis (HypothesisJudge: is it worth
+  // refining?) tests at most this many: its thresholds are wide, and half
+  // of all hypotheses end there. [10, 1e7], and never more than max_samples.
+  // Count.
+  int gate_max_samples = 1000;
   // Pixels within this distance of the box's projected outline that do not
   // agree (seen through or no return) are counted as `border`, not against
   // the box: stereo edge fattening, flying and mixed pixels between a box

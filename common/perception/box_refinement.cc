@@ -49,14 +49,37 @@ FaceFrame MakeFaceFrame(const Eigen::Isometry3d& camera_T_box, const BoxDims& di
   return f;
 }
 
-// Measured points near the face, in face coordinates.
-// Points in front of the plane (an occluder) go to `front`; where every
-// pixel's ray meets the plane goes to `grid` (what a fully seen face would
-// give: the reference for point densities), within `margin` of a side only,
-// since only the seam scan along the sides reads it.
-std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margin,
-                                         double plane_tol, std::vector<FacePoint>* front,
-                                         std::vector<FacePoint>* grid) {
+// Measured points near the face, in face coordinates, as the refinement
+// reads them: the plane fit reads the interior, each side's measurement
+// only the band along it, so each side gets its own copy of its band
+// (every point with sign * coordinate >= half - margin, in pixel order; a
+// corner's points are in two bands). Per side: the points on the plane,
+// the points in front of it (an occluder) and where every pixel's ray meets
+// the plane (what a fully seen face would give: the reference for point
+// densities).
+struct FacePoints {
+  // The points on the plane >= 1 cm inside every side, as their count and
+  // the sums of their coordinates and products (all the plane fit needs).
+  int interior = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
+  std::array<std::vector<FacePoint>, 4> on_plane, front, grid;  // +a, -a, +b, -b bands
+};
+
+// Side order +a, -a, +b, -b, as RefinementResult::sides.
+int SideIndex(bool along_a, double sign) { return (along_a ? 0 : 2) + (sign > 0.0 ? 0 : 1); }
+
+// Fills *out (its vectors cleared first: a caller that keeps it keeps their
+// capacity, and a refinement then allocates nothing).
+void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margin,
+                       double plane_tol, FacePoints* out_points) {
+  FacePoints& out = *out_points;
+  out.interior = 0;
+  out.sum.setZero();
+  out.sum_outer.setZero();
+  for (auto* lists : {&out.on_plane, &out.front, &out.grid}) {
+    for (std::vector<FacePoint>& l : *lists) l.clear();
+  }
   const CameraIntrinsics& k = depth.camera;
   std::vector<Eigen::Vector3d> outline;
   for (double sa : {-1.0, 1.0}) {
@@ -65,12 +88,18 @@ std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFram
     }
   }
   const std::optional<PixelRect> rect = ProjectedRect(k, outline);
-  if (!rect) return {};
+  if (!rect) return;
   const int ua = rect->u0, ub = rect->u1, va = rect->v0, vb = rect->v1;
-  std::vector<FacePoint> pts;
-  const size_t area = static_cast<size_t>(ub - ua + 1) * (vb - va + 1);
-  pts.reserve(area);
-  grid->reserve(area / 2);
+  // The bands' inner edges, a hair inside so that each reader's own test
+  // (which may round the other way) sees every point it would have seen.
+  const double band_a = f.half_a - margin - 1e-9, band_b = f.half_b - margin - 1e-9;
+  auto to_sides = [&](const FacePoint& q, std::array<std::vector<FacePoint>, 4>& sides) {
+    if (q.a >= band_a) sides[0].push_back(q);
+    if (-q.a >= band_a) sides[1].push_back(q);
+    if (q.b >= band_b) sides[2].push_back(q);
+    if (-q.b >= band_b) sides[3].push_back(q);
+  };
+  const double inside_a = f.half_a - 0.01, inside_b = f.half_b - 0.01;
   // Per pixel ray r = (x_u, y_v, 1), the face coordinates are linear in r:
   // a measured point z r has a = z (a.r) - a.c (and b, n alike), and the ray
   // meets the plane at s r with s = (n.c) / (n.r). The dot products with r
@@ -106,27 +135,41 @@ std::vector<FacePoint> CollectFacePoints(const DepthImage& depth, const FaceFram
       skip0 += 1.0;
       skip1 -= 1.0;
     }
+    double sa = 0, sb = 0, sn = 0, saa = 0, sab = 0, san = 0, sbb = 0, sbn = 0, snn = 0;
     for (int u = ua; u <= ub; ++u) {
       const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row, n_r = n_x[u - ua] + n_row;
       if ((u <= skip0 || u >= skip1) && std::abs(n_r) > 1e-6) {
         const double t = n_c / n_r;
         const FacePoint q{t * a_r - a_c, t * b_r - b_c, 0.0};
         const double qa = std::abs(q.a), qb = std::abs(q.b);
-        if (qa <= lim_a && qb <= lim_b && (qa > in_a || qb > in_b)) grid->push_back(q);
+        if (qa <= lim_a && qb <= lim_b && (qa > in_a || qb > in_b)) to_sides(q, out.grid);
       }
       const float z = zrow[u];
       if (std::isnan(z)) continue;
       const FacePoint q{z * a_r - a_c, z * b_r - b_c, z * n_r - n_c};
       if (std::abs(q.a) > lim_a || std::abs(q.b) > lim_b) continue;
       if (q.n > plane_tol) {
-        front->push_back(q);
+        to_sides(q, out.front);
         continue;
       }
       if (q.n < -plane_tol) continue;
-      pts.push_back(q);
+      if (!(std::abs(q.a) > inside_a || std::abs(q.b) > inside_b)) {
+        ++out.interior;
+        sa += q.a;
+        sb += q.b;
+        sn += q.n;
+        saa += q.a * q.a;
+        sab += q.a * q.b;
+        san += q.a * q.n;
+        sbb += q.b * q.b;
+        sbn += q.b * q.n;
+        snn += q.n * q.n;
+      }
+      to_sides(q, out.on_plane);
     }
+    out.sum += Eigen::Vector3d(sa, sb, sn);
+    out.sum_outer += (Eigen::Matrix3d() << saa, sab, san, sab, sbb, sbn, san, sbn, snn).finished();
   }
-  return pts;
 }
 
 // One side of the face: where it ends along `sign * a` (or b), and its turn.
@@ -322,9 +365,12 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
   return half + *best;
 }
 
-SideMeasure MeasureSide(const std::vector<FacePoint>& pts, const std::vector<FacePoint>& front,
-                        const std::vector<FacePoint>& grid, bool along_a, double sign, double half,
+SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, double half,
                         double half_other, double pixel_m, const RefinementOptions& o) {
+  const int side = SideIndex(along_a, sign);
+  const std::vector<FacePoint>& pts = face.on_plane[side];
+  const std::vector<FacePoint>& front = face.front[side];
+  const std::vector<FacePoint>& grid = face.grid[side];
   const double band = o.side_band_m;
   int inner = 0, outer = 0;
   const double bin = 0.01;
@@ -528,26 +574,16 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
                 const RefinementOptions& options, Eigen::Isometry3d& pose,
                 RefinementResult& result) {
   FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
-  std::vector<FacePoint> front, grid;
-  const std::vector<FacePoint> pts =
-      CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m, &front, &grid);
+  thread_local FacePoints face;  // reused: its vectors keep their capacity
+  CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m, &face);
   const double pixel_m = f.c.z() / depth.camera.fx;  // point spacing on the face
-  // Plane through the interior points.
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  int n = 0;
-  for (const FacePoint& p : pts) {
-    if (std::abs(p.a) > f.half_a - 0.01 || std::abs(p.b) > f.half_b - 0.01) continue;
-    mean += Eigen::Vector3d(p.a, p.b, p.n);
-    ++n;
-  }
+  // Plane through the interior points: their scatter about the mean is
+  // sum(q q^T) - n mean mean^T (face coordinates are centimetres to a
+  // metre, so the difference loses nothing that matters in doubles).
+  const int n = face.interior;
   if (n < 30) return false;
-  mean /= n;
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const FacePoint& p : pts) {
-    if (std::abs(p.a) > f.half_a - 0.01 || std::abs(p.b) > f.half_b - 0.01) continue;
-    const Eigen::Vector3d d = Eigen::Vector3d(p.a, p.b, p.n) - mean;
-    cov += d * d.transpose();
-  }
+  const Eigen::Vector3d mean = face.sum / n;
+  const Eigen::Matrix3d cov = face.sum_outer - n * mean * mean.transpose();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
   Eigen::Vector3d normal_local = eig.eigenvectors().col(0);
   if (normal_local.z() < 0.0) normal_local = -normal_local;
@@ -555,10 +591,10 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
   result.face_points = n;
 
   // Sides: +a, -a, +b, -b.
-  SideMeasure pa = MeasureSide(pts, front, grid, true, 1.0, f.half_a, f.half_b, pixel_m, options);
-  SideMeasure ma = MeasureSide(pts, front, grid, true, -1.0, f.half_a, f.half_b, pixel_m, options);
-  SideMeasure pb = MeasureSide(pts, front, grid, false, 1.0, f.half_b, f.half_a, pixel_m, options);
-  SideMeasure mb = MeasureSide(pts, front, grid, false, -1.0, f.half_b, f.half_a, pixel_m, options);
+  SideMeasure pa = MeasureSide(face, true, 1.0, f.half_a, f.half_b, pixel_m, options);
+  SideMeasure ma = MeasureSide(face, true, -1.0, f.half_a, f.half_b, pixel_m, options);
+  SideMeasure pb = MeasureSide(face, false, 1.0, f.half_b, f.half_a, pixel_m, options);
+  SideMeasure mb = MeasureSide(face, false, -1.0, f.half_b, f.half_a, pixel_m, options);
   // Where the depth shows the face running on with no seam, a straight
   // line in the colour image along the whole side is one.
   if (depth.has_grey()) {

@@ -136,7 +136,9 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   cand.box.num_corners = p.corners;
   cand.box.segments = p.segments;
   cand.box.from_face = p.from_face;
-  const BoxEvidence first = MeasureBox(depth_, p.camera_T_box, options_.box, options_.evidence);
+  EvidenceOptions gate = options_.evidence;
+  gate.max_samples = std::min(gate.max_samples, gate.gate_max_samples);
+  const BoxEvidence first = MeasureBox(depth_, p.camera_T_box, options_.box, gate);
   // Refinement moves a hypothesis by centimetres at most: one that the
   // depth image already rejects by a wide margin is not worth refining.
   const BoxFace grasp = first.grasp_face;
