@@ -27,8 +27,8 @@ absl::Status EvidenceOptions::Validate() const {
         absl::StrCat("evidence max_samples=", max_samples, " is outside [10, 1e7]"));
   }
   if (gate_max_samples < 10 || gate_max_samples > 10000000) {
-    return absl::InvalidArgumentError(absl::StrCat("evidence gate_max_samples=", gate_max_samples,
-                                                   " is outside [10, 1e7]"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("evidence gate_max_samples=", gate_max_samples, " is outside [10, 1e7]"));
   }
   return absl::OkStatus();
 }

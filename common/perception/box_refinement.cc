@@ -71,8 +71,8 @@ int SideIndex(bool along_a, double sign) { return (along_a ? 0 : 2) + (sign > 0.
 
 // Fills *out (its vectors cleared first: a caller that keeps it keeps their
 // capacity, and a refinement then allocates nothing).
-void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margin,
-                       double plane_tol, FacePoints* out_points) {
+void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margin, double plane_tol,
+                       FacePoints* out_points) {
   FacePoints& out = *out_points;
   out.interior = 0;
   out.sum.setZero();
