@@ -104,15 +104,24 @@ class OrganizedScorer {
 
   // Full-resolution pass over the rows [row_begin, row_end) of the lattice
   // of every `lattice` pixels; with `cells` (1: score the cell's pixels,
-  // cells of cell_px), only those pixels are scored.
+  // cells of cell_px), only those pixels are scored, and a cell's centre
+  // pixel takes its score from `cell_scores` (ScoreCoarse's, the same
+  // computation).
   void ScoreRows(int row_begin, int row_end, int lattice, int cell_px,
-                 const std::vector<uint8_t>* cells, Chunk* out) const {
+                 const std::vector<uint8_t>* cells, const std::vector<float>* cell_scores,
+                 Chunk* out) const {
     const int w = cloud_.width;
     const int cells_w = (w + cell_px - 1) / cell_px;
+    const int centre = (cell_px / lattice / 2) * lattice;
     for (int v = (row_begin + lattice - 1) / lattice * lattice; v < row_end; v += lattice) {
+      const int cv = v / cell_px;
+      const bool centre_row = v == std::min(cv * cell_px + centre, cloud_.height - 1);
       for (int u = 0; u < w; u += lattice) {
-        if (cells != nullptr && !(*cells)[(v / cell_px) * cells_w + u / cell_px]) continue;
-        const float score = ScoreAt(u, v);
+        const int cu = u / cell_px;
+        if (cells != nullptr && !(*cells)[cv * cells_w + cu]) continue;
+        const bool scored = cell_scores != nullptr && centre_row &&
+                            u == std::min(cu * cell_px + centre, w - 1);
+        const float score = scored ? (*cell_scores)[cv * cells_w + cu] : ScoreAt(u, v);
         if (score <= options_.threshold) continue;
         const Eigen::Vector3f& p = cloud_.xyz[v * w + u];
         const float radius_px = static_cast<float>(options_.radius_m) * focal_px_ / p.z();
@@ -302,7 +311,7 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
   if (step <= 1) {
     internal::ParallelForChunks(cloud.height, kRowsPerBlock, options.num_threads,
                                 [&](int c, int begin, int end) {
-                                  scorer.ScoreRows(begin, end, lattice, 1, nullptr, &chunks[c]);
+                                  scorer.ScoreRows(begin, end, lattice, 1, nullptr, nullptr, &chunks[c]);
                                 });
     return Merge(cloud, chunks);
   }
@@ -340,7 +349,8 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
   }
   internal::ParallelForChunks(cloud.height, kRowsPerBlock, options.num_threads,
                               [&](int c, int begin, int end) {
-                                scorer.ScoreRows(begin, end, lattice, cell_px, &cells, &chunks[c]);
+                                scorer.ScoreRows(begin, end, lattice, cell_px, &cells, &cell_scores,
+                                                 &chunks[c]);
                               });
   return Merge(cloud, chunks);
 }
