@@ -51,6 +51,14 @@ ABSL_FLAG(std::string, http_listen, cornerpose::server::kDefaultHttpListen,
           "a free one; empty turns it off)");
 ABSL_FLAG(std::string, cell_status_address, "",
           "host:port of the robot-cell daemon's status service, shown by the web view");
+ABSL_FLAG(std::string, cell_status_tls_ca, "",
+          "PEM CA of the daemon status service's certificate: TLS to --cell_status_address");
+ABSL_FLAG(std::string, cell_status_tls_cert, "",
+          "PEM client certificate for a status service that requires one (with "
+          "--cell_status_tls_key)");
+ABSL_FLAG(std::string, cell_status_tls_key, "", "PEM private key of --cell_status_tls_cert");
+ABSL_FLAG(std::string, cell_status_tls_server_name, "",
+          "name to check the status service's certificate for, when not the address's host");
 ABSL_FLAG(std::string, view_box, cornerpose::server::HttpOptions{}.view_box,
           "the box the web view detects when the page names none (model name or L,B,H)");
 ABSL_FLAG(std::string, log_format, "text", "log lines as text or json (one object per line)");
@@ -188,6 +196,18 @@ int main(int argc, char** argv) {
   if (given("http_listen")) options.http.listen_address = absl::GetFlag(FLAGS_http_listen);
   if (given("cell_status_address")) {
     options.http.cell_status_address = absl::GetFlag(FLAGS_cell_status_address);
+  }
+  if (given("cell_status_tls_ca")) {
+    options.http.cell_status_tls_ca = absl::GetFlag(FLAGS_cell_status_tls_ca);
+  }
+  if (given("cell_status_tls_cert")) {
+    options.http.cell_status_tls_cert = absl::GetFlag(FLAGS_cell_status_tls_cert);
+  }
+  if (given("cell_status_tls_key")) {
+    options.http.cell_status_tls_key = absl::GetFlag(FLAGS_cell_status_tls_key);
+  }
+  if (given("cell_status_tls_server_name")) {
+    options.http.cell_status_tls_server_name = absl::GetFlag(FLAGS_cell_status_tls_server_name);
   }
   if (given("view_box")) options.http.view_box = absl::GetFlag(FLAGS_view_box);
   const auto take_int = [&](absl::string_view name, const absl::Flag<int>& flag, int* out) {

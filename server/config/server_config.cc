@@ -82,6 +82,10 @@ absl::StatusOr<ServerOptions> LoadServerConfig(const std::string& path) {
   options.tls_cert = resolve(config.tls_cert());
   options.tls_key = resolve(config.tls_key());
   options.tls_client_ca = resolve(config.tls_client_ca());
+  options.http.cell_status_tls_ca = resolve(config.cell_status_tls_ca());
+  options.http.cell_status_tls_cert = resolve(config.cell_status_tls_cert());
+  options.http.cell_status_tls_key = resolve(config.cell_status_tls_key());
+  options.http.cell_status_tls_server_name = config.cell_status_tls_server_name();
   if (config.has_enable_reflection()) options.enable_reflection = config.enable_reflection();
   if (absl::Status s = options.Validate(); !s.ok()) return Invalid(path, std::string(s.message()));
   std::set<std::string> names;

@@ -4,6 +4,9 @@
 #include <grpcpp/security/credentials.h>
 
 #include <chrono>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
 #include <nlohmann/json.hpp>
 
 namespace cornerpose::server {
@@ -22,10 +25,19 @@ std::string Short(const std::string& name, const std::string& prefix) {
 
 }  // namespace
 
-CellStatusClient::CellStatusClient(std::string address)
-    : address_(std::move(address)),
-      stub_(v1::RobotClientService::NewStub(
-          grpc::CreateChannel(address_, grpc::InsecureChannelCredentials()))) {}
+absl::StatusOr<std::unique_ptr<CellStatusClient>> CellStatusClient::Create(
+    std::string address, const ClientTlsFiles& tls) {
+  grpc::ChannelArguments args;
+  absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> credentials =
+      MakeChannelCredentials(tls, &args);
+  if (!credentials.ok()) {
+    return absl::Status(credentials.status().code(),
+                        absl::StrCat("cell status TLS: ", credentials.status().message()));
+  }
+  auto stub =
+      v1::RobotClientService::NewStub(grpc::CreateCustomChannel(address, *credentials, args));
+  return std::unique_ptr<CellStatusClient>(new CellStatusClient(std::move(address), std::move(stub)));
+}
 
 std::string CellStatusClient::StatusJson() {
   json out = {{"configured", true}, {"address", address_}};

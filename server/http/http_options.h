@@ -20,6 +20,14 @@ struct HttpOptions {
   // host:port of the robot-cell daemon's status service
   // (RobotClientService) for /api/cell; "" = not configured.
   std::string cell_status_address;
+  // TLS to that service, as the daemon serves it (its status_tls_*): the CA
+  // of its certificate, and this server's client certificate and key for a
+  // daemon that requires one; the name to check its certificate for when
+  // not the address's host. All empty: plaintext.
+  std::string cell_status_tls_ca;
+  std::string cell_status_tls_cert;
+  std::string cell_status_tls_key;
+  std::string cell_status_tls_server_name;
   // The box the view detects on a source's frames when the page names none:
   // a model name (built-in or the configuration's box_models) or "L,B,H".
   std::string view_box = "carton_s";

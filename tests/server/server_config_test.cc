@@ -225,5 +225,20 @@ TEST(ServerConfigTest, HttpFieldsAreRead) {
   EXPECT_EQ(options->http.view_box, "brick");
 }
 
+TEST(ServerConfigTest, CellStatusTlsPathsAreRelativeToTheFile) {
+  const std::string path = WriteConfig(
+      "cell_tls.textproto",
+      "cell_status_address: \"cell:50061\"\ncell_status_tls_ca: \"certs/ca.pem\"\n"
+      "cell_status_tls_cert: \"/etc/cp/client.pem\"\ncell_status_tls_key: \"client.key\"\n"
+      "cell_status_tls_server_name: \"cell.internal\"\n");
+  const absl::StatusOr<ServerOptions> options = LoadServerConfig(path);
+  ASSERT_TRUE(options.ok()) << options.status();
+  const fs::path dir = fs::path(path).parent_path();
+  EXPECT_EQ(options->http.cell_status_tls_ca, (dir / "certs/ca.pem").string());
+  EXPECT_EQ(options->http.cell_status_tls_cert, "/etc/cp/client.pem");
+  EXPECT_EQ(options->http.cell_status_tls_key, (dir / "client.key").string());
+  EXPECT_EQ(options->http.cell_status_tls_server_name, "cell.internal");
+}
+
 }  // namespace
 }  // namespace cornerpose::server

@@ -19,11 +19,18 @@
 #include <vector>
 
 #include "common/grpc_security/tls.h"
+#include "robot_client/cell/cell_controller.h"
+#include "robot_client/cell/perception_subscriber.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "robot_client/cell/status_service.h"
 #include "server/server.h"
 #include "tools/client/client_commands.h"
+// After Eigen (through the cell controller): httplib's headers define macros
+// that break Eigen's when they come first.
+#include <httplib.h>
+
+#include <nlohmann/json.hpp>
 
 namespace cornerpose::server {
 namespace {
@@ -173,6 +180,65 @@ TEST(ServerTlsTest, StatusServiceOfTheDaemonTakesMutualTls) {
   EXPECT_EQ(CheckHealth(Channel(port, ClientOf(Certs().other))).error_code(),
             grpc::StatusCode::UNAVAILABLE);
   EXPECT_EQ(CheckHealth(Channel(port, {})).error_code(), grpc::StatusCode::UNAVAILABLE);
+}
+
+// The web view's /api/cell asks the daemon's status service over mutual
+// TLS when given the files, as the daemon serves it; without them it shows
+// the daemon as unreachable (a TLS port refuses plaintext) and keeps
+// serving. The daemon here is a real controller, not running: its status
+// is the one it starts with.
+TEST(ServerTlsTest, WebViewReadsTheDaemonsStatusOverMutualTls) {
+  robot_client::PerceptionSubscriber perception({});
+  robot_client::RobotClientOptions cell_options;
+  cell_options.dry_run = true;
+  robot_client::CellController cell(cell_options, {}, &perception);
+  absl::StatusOr<std::unique_ptr<robot_client::StatusServer>> status =
+      robot_client::StartStatusServer("127.0.0.1:0", &cell, MutualTls());
+  ASSERT_TRUE(status.ok()) << status.status();
+  const std::string daemon = "127.0.0.1:" + std::to_string((*status)->port());
+
+  auto cell_json = [&](const ClientTlsFiles& tls) {
+    ServerOptions options;
+    options.listen_address = "127.0.0.1:0";
+    options.http.listen_address = "127.0.0.1:0";
+    options.http.cell_status_address = daemon;
+    options.http.cell_status_tls_ca = tls.ca;
+    options.http.cell_status_tls_cert = tls.cert;
+    options.http.cell_status_tls_key = tls.key;
+    absl::StatusOr<std::unique_ptr<RunningServer>> server = StartServer(options);
+    EXPECT_TRUE(server.ok()) << server.status();
+    if (!server.ok()) return nlohmann::json();
+    httplib::Client http("127.0.0.1", (*server)->http_port());
+    httplib::Result res = http.Get("/api/cell");
+    EXPECT_TRUE(res && res->status == 200);
+    return res ? nlohmann::json::parse(res->body, nullptr, false) : nlohmann::json();
+  };
+
+  const nlohmann::json secure = cell_json(ClientOf(Certs().good));
+  EXPECT_EQ(secure["reachable"], true) << secure.dump();
+  EXPECT_EQ(secure["dry_run"], true) << secure.dump();
+  EXPECT_TRUE(secure["state"].is_string()) << secure.dump();
+
+  for (const ClientTlsFiles& tls : {ClientTlsFiles{}, ClientOf(Certs().other)}) {
+    const nlohmann::json refused = cell_json(tls);
+    EXPECT_EQ(refused["reachable"], false) << refused.dump();
+    EXPECT_TRUE(refused["error"].is_string()) << refused.dump();
+  }
+}
+
+TEST(ServerTlsTest, BadCellStatusTlsFilesAreRefusedAtStart) {
+  ServerOptions options;
+  options.listen_address = "127.0.0.1:0";
+  options.http.listen_address = "127.0.0.1:0";
+  options.http.cell_status_address = "127.0.0.1:1";
+  options.http.cell_status_tls_ca = "/nonexistent/ca.pem";
+  absl::StatusOr<std::unique_ptr<RunningServer>> server = StartServer(options);
+  ASSERT_FALSE(server.ok());
+  EXPECT_EQ(server.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_NE(server.status().message().find("cell status TLS"), std::string::npos)
+      << server.status();
+  EXPECT_NE(server.status().message().find("/nonexistent/ca.pem"), std::string::npos)
+      << server.status();
 }
 
 TEST(ServerTlsTest, CliHealthTakesTlsFlags) {
