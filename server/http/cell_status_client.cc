@@ -4,10 +4,10 @@
 #include <grpcpp/security/credentials.h>
 
 #include <chrono>
+#include <nlohmann/json.hpp>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include <nlohmann/json.hpp>
 
 namespace cornerpose::server {
 namespace {
@@ -36,7 +36,8 @@ absl::StatusOr<std::unique_ptr<CellStatusClient>> CellStatusClient::Create(
   }
   auto stub =
       v1::RobotClientService::NewStub(grpc::CreateCustomChannel(address, *credentials, args));
-  return std::unique_ptr<CellStatusClient>(new CellStatusClient(std::move(address), std::move(stub)));
+  return std::unique_ptr<CellStatusClient>(
+      new CellStatusClient(std::move(address), std::move(stub)));
 }
 
 std::string CellStatusClient::StatusJson() {

@@ -21,7 +21,7 @@ class CellStatusClient {
   // NOT_FOUND (naming the file) for TLS files that do not go together or
   // cannot be read.
   static absl::StatusOr<std::unique_ptr<CellStatusClient>> Create(std::string address,
-                                                                 const ClientTlsFiles& tls);
+                                                                  const ClientTlsFiles& tls);
 
   // {"configured": true, "reachable": ..., ...}; each call asks the daemon
   // (one second deadline), so a stopped daemon shows as unreachable.

@@ -135,11 +135,10 @@ absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(
   }
   if (!options.cell_status_address.empty()) {
     absl::StatusOr<std::unique_ptr<CellStatusClient>> cell = CellStatusClient::Create(
-        options.cell_status_address,
-        {.ca = options.cell_status_tls_ca,
-         .cert = options.cell_status_tls_cert,
-         .key = options.cell_status_tls_key,
-         .server_name = options.cell_status_tls_server_name});
+        options.cell_status_address, {.ca = options.cell_status_tls_ca,
+                                      .cert = options.cell_status_tls_cert,
+                                      .key = options.cell_status_tls_key,
+                                      .server_name = options.cell_status_tls_server_name});
     if (!cell.ok()) return cell.status();
     server->cell_ = *std::move(cell);
   }

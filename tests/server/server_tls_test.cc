@@ -19,10 +19,10 @@
 #include <vector>
 
 #include "common/grpc_security/tls.h"
-#include "robot_client/cell/cell_controller.h"
-#include "robot_client/cell/perception_subscriber.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "grpc/health/v1/health.grpc.pb.h"
+#include "robot_client/cell/cell_controller.h"
+#include "robot_client/cell/perception_subscriber.h"
 #include "robot_client/cell/status_service.h"
 #include "server/server.h"
 #include "tools/client/client_commands.h"
