@@ -460,8 +460,16 @@ void ColourSeamSide(const DepthImage& depth, const FaceFrame& f, bool along_a, d
 // where the face ends. Looks up to 8 cm out along three lines.
 bool ShadowedByOccluder(const DepthImage& depth, const Eigen::Vector3d& side_centre,
                         const Eigen::Vector3d& across, const Eigen::Vector3d& along,
-                        double half_along, const Eigen::Vector3d& normal,
+                        double half_along, const Eigen::Vector3d& normal, const BoxDims& dims,
                         const RefinementOptions& o) {
+  // Right past the side (no shadow between), a surface a whole box
+  // dimension above the face is the top of a box standing on it.
+  auto rests_on_face = [&](double height) {
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(height - dims[k]) < 0.025) return true;
+    }
+    return false;
+  };
   for (double t : {-0.6, 0.0, 0.6}) {
     const Eigen::Vector3d start = side_centre + t * half_along * along;
     for (double d = 0.004; d < 0.08; d += 0.003) {
@@ -474,7 +482,7 @@ bool ShadowedByOccluder(const DepthImage& depth, const Eigen::Vector3d& side_cen
       const float z = depth.at(u, v);
       if (std::isnan(z)) continue;
       const double height = (z * PixelRay(depth.camera, u, v) - q).dot(normal);
-      if (height > o.plane_tolerance_m && d > 0.012) return true;
+      if (height > o.plane_tolerance_m && (d > 0.012 || rests_on_face(height))) return true;
       break;  // a surface at or behind the plane: a real end
     }
   }
@@ -658,7 +666,7 @@ void MarkShadowedSides(const DepthImage& depth, const BoxDims& dims, BoxFace gra
   for (int i = 0; i < 4; ++i) {
     if (result.sides[i] == SideKind::kFree &&
         ShadowedByOccluder(depth, f.c + half_across[i] * across[i], across[i], along[i],
-                           half_along[i], f.n, options)) {
+                           half_along[i], f.n, dims, options)) {
       result.sides[i] = SideKind::kOccluded;
       --result.free_sides;
     }
