@@ -9,12 +9,14 @@
 #include <string>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "common/perception/camera_model.h"
 #include "common/perception/internal/box_overlap.h"
 #include "common/perception/internal/hypothesis_judge.h"
+#include "common/perception/internal/parallel.h"
 #include "common/perception/neighbour_hypotheses.h"
 #include "common/validation/range_check.h"
 
@@ -317,9 +319,8 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   DetectorOptions options = options_in;
   options.edge_points.num_threads = options.num_threads;
   // With face proposals, one thread finds the planar patches while the
-  // others fit the segments (below).
-  options.segments.num_threads =
-      options.face_proposals ? std::max(1, options.num_threads - 1) : options.num_threads;
+  // others fit the segments, and then helps them (below).
+  options.segments.num_threads = options.num_threads;
   Detection det;
 
   // Preprocess: the camera and its depth image.
@@ -374,19 +375,31 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   // are found on a thread of their own while the edge points become
   // segments and corners.
   // (A jthread: joined on every path out, an error below returns early.)
+  // Done with them, that thread helps fit the segments (their RANSAC
+  // iterations are shared loops), so neither stage waits on the other.
+  // Beyond two threads, the others help from the start.
   FaceProposals faces;
+  internal::SharedLoops shared;
+  const bool share = options.face_proposals && options.num_threads > 1;
   std::jthread faces_thread;
   if (options.face_proposals) {
     faces_thread = std::jthread([&] {
       const Clock::time_point t_faces = Clock::now();
       faces = ProposeFromFaces(depth, options.box, options.faces);
       det.timings.faces_ms = MsSince(t_faces);
+      if (share) shared.Help();
     });
+  }
+  std::vector<std::jthread> helpers;
+  for (int t = 2; share && t < options.num_threads; ++t) {
+    helpers.emplace_back([&] { shared.Help(); });
   }
 
   t0 = Clock::now();
   absl::StatusOr<std::vector<EdgeSegment>> segments =
-      FitEdgeSegments(det.edge_points, options.segments);
+      FitEdgeSegments(det.edge_points, options.segments, share ? &shared : nullptr);
+  shared.Close();
+  helpers.clear();  // joined
   if (!segments.ok()) return segments.status();
   det.segments = *std::move(segments);
   det.timings.edge_segments_ms = MsSince(t0);

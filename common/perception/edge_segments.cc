@@ -76,14 +76,16 @@ class Grid {
 
 class SegmentFitter {
  public:
-  SegmentFitter(const std::vector<Eigen::Vector3f>& pts, const EdgeSegmentOptions& o)
+  SegmentFitter(const std::vector<Eigen::Vector3f>& pts, const EdgeSegmentOptions& o,
+                internal::SharedLoops* shared)
       : pts_(pts),
         options_(o),
         alive_(pts.size(), 1),
         num_alive_(static_cast<int>(pts.size())),
         grid_(pts, static_cast<float>(o.sample_max_m / 2.0)),
         rng_(o.seed),
-        pool_(o.num_threads) {}
+        shared_(shared),
+        pool_(shared != nullptr ? 1 : o.num_threads) {}
 
   std::vector<EdgeSegment> Run() {
     std::vector<EdgeSegment> segments;
@@ -154,7 +156,7 @@ class SegmentFitter {
     }
     std::vector<int> counts(iterations, -1);
     std::vector<Line> lines(iterations);
-    pool_.Run(iterations, [&](int, int begin, int end) {
+    auto iterate = [&](int begin, int end) {
       std::vector<int> candidates;
       for (int it = begin; it < end; ++it) {
         const int a = first[it];
@@ -171,7 +173,14 @@ class SegmentFitter {
         lines[it].direction = (pts_[candidates[k]] - pts_[a]).normalized();
         counts[it] = CountWithin(lines[it], t2);
       }
-    });
+    };
+    // Chunks of 8 iterations: ~15 per loop, enough to share with a helper
+    // that joins late.
+    if (shared_ != nullptr) {
+      shared_->Run(iterations, 8, iterate);
+    } else {
+      pool_.Run(iterations, [&](int, int begin, int end) { iterate(begin, end); });
+    }
     std::optional<Line> best;
     int best_count = 0;
     for (int it = 0; it < iterations; ++it) {
@@ -308,6 +317,7 @@ class SegmentFitter {
   Grid grid_;
   std::mt19937 rng_;
   std::vector<float> sx_, sy_, sz_;  // the current RANSAC subset
+  internal::SharedLoops* const shared_;  // null: pool_ runs the iterations
   internal::ForkJoin pool_;
 };
 
@@ -394,9 +404,10 @@ std::pair<int, int> FindExtremities(const std::vector<Eigen::Vector3f>& points, 
 }
 
 absl::StatusOr<std::vector<EdgeSegment>> FitEdgeSegments(
-    const std::vector<Eigen::Vector3f>& edge_points, const EdgeSegmentOptions& options) {
+    const std::vector<Eigen::Vector3f>& edge_points, const EdgeSegmentOptions& options,
+    internal::SharedLoops* shared) {
   if (absl::Status s = options.Validate(); !s.ok()) return s;
-  SegmentFitter fitter(edge_points, options);
+  SegmentFitter fitter(edge_points, options, shared);
   return fitter.Run();
 }
 

@@ -56,8 +56,15 @@ struct EdgeSegmentOptions {
 std::pair<int, int> FindExtremities(const std::vector<Eigen::Vector3f>& points, int reference,
                                     double radius_m);
 
-// Fits all edge segments in a set of edge points.
+namespace internal {
+class SharedLoops;
+}
+
+// Fits all edge segments in a set of edge points. With `shared`, the RANSAC
+// iterations run on it (the caller's thread and whichever threads help;
+// options.num_threads is then not used), with the same result.
 absl::StatusOr<std::vector<EdgeSegment>> FitEdgeSegments(
-    const std::vector<Eigen::Vector3f>& edge_points, const EdgeSegmentOptions& options);
+    const std::vector<Eigen::Vector3f>& edge_points, const EdgeSegmentOptions& options,
+    internal::SharedLoops* shared = nullptr);
 
 }  // namespace cornerpose

@@ -4,11 +4,16 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <numbers>
 #include <random>
+#include <thread>
 #include <vector>
+
+#include "common/perception/internal/parallel.h"
 
 namespace cornerpose {
 namespace {
@@ -244,6 +249,55 @@ TEST(FitEdgeSegmentsTest, SameSegmentsOnAnyNumberOfThreads) {
     EXPECT_EQ((*a)[i].end2, (*b)[i].end2);
     EXPECT_EQ((*a)[i].num_points, (*b)[i].num_points);
   }
+}
+
+// The same with the iterations on shared loops (internal::SharedLoops), as
+// the detector runs them: a helper that joins late, or two from the start,
+// change nothing either.
+TEST(FitEdgeSegmentsTest, SameSegmentsOnSharedLoopsWithLateAndEarlyHelpers) {
+  std::vector<Eigen::Vector3f> pts = RectangleOutline(TiltedRectangle(), 6);
+  const std::vector<Eigen::Vector3f> more = RectangleOutline(TiltedRectangle(), 4);
+  for (const Eigen::Vector3f& p : more) pts.push_back(p + Eigen::Vector3f(0.5f, 0.1f, 0.05f));
+  EdgeSegmentOptions one;
+  one.num_threads = 1;
+  const auto reference = FitEdgeSegments(pts, one);
+  ASSERT_TRUE(reference.ok());
+  ASSERT_GE(reference->size(), 8u);
+  for (const int helpers : {0, 1, 2}) {
+    internal::SharedLoops shared;
+    std::vector<std::jthread> threads;
+    for (int h = 0; h < helpers; ++h) {
+      threads.emplace_back([&shared, h] {
+        // The first helper arrives once the fit is under way.
+        if (h == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        shared.Help();
+      });
+    }
+    const auto got = FitEdgeSegments(pts, one, &shared);
+    shared.Close();
+    ASSERT_TRUE(got.ok());
+    ASSERT_EQ(got->size(), reference->size()) << helpers << " helpers";
+    for (size_t i = 0; i < got->size(); ++i) {
+      EXPECT_EQ((*got)[i].end1, (*reference)[i].end1) << helpers << " helpers";
+      EXPECT_EQ((*got)[i].end2, (*reference)[i].end2) << helpers << " helpers";
+      EXPECT_EQ((*got)[i].num_points, (*reference)[i].num_points) << helpers << " helpers";
+    }
+  }
+}
+
+// Every index of every loop runs exactly once, whoever takes it.
+TEST(SharedLoopsTest, EveryIndexRunsOnceWithHelpers) {
+  internal::SharedLoops shared;
+  std::vector<std::jthread> helpers;
+  for (int h = 0; h < 2; ++h) helpers.emplace_back([&shared] { shared.Help(); });
+  for (int n : {1, 7, 8, 9, 100, 1000}) {
+    std::vector<std::atomic<int>> runs(n);
+    shared.Run(n, 8, [&](int begin, int end) {
+      for (int i = begin; i < end; ++i) runs[i].fetch_add(1);
+    });
+    for (int i = 0; i < n; ++i) ASSERT_EQ(runs[i].load(), 1) << "n " << n << " index " << i;
+  }
+  shared.Close();
 }
 
 TEST(FitEdgeSegmentsTest, EmptyAndSparseInputGiveNoSegments) {

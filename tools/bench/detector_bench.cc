@@ -184,7 +184,7 @@ double Quantile(std::vector<double> v, double q) {
 
 void BM_ClutterSet(benchmark::State& state) {
   const std::vector<Frame>& frames = ClutterSet();
-  std::vector<double> total, edges, segments, poses;
+  std::vector<double> total, edges, segments, faces, poses;
   int correct = 0, pickable = 0, returned = 0, proposed = 0, refined = 0, accepted = 0;
   // A digest of what was found (poses, scores, edge points, segments): equal
   // digests across builds mean the same detections.
@@ -204,6 +204,7 @@ void BM_ClutterSet(benchmark::State& state) {
       total.push_back(d->timings.total_ms);
       edges.push_back(d->timings.edge_points_ms);
       segments.push_back(d->timings.edge_segments_ms);
+      faces.push_back(d->timings.faces_ms);
       poses.push_back(d->timings.poses_ms);
       correct += CorrectBoxes(*d, f.truth);
       proposed += d->hypotheses.proposed;
@@ -223,6 +224,7 @@ void BM_ClutterSet(benchmark::State& state) {
   state.counters["p90_ms"] = Quantile(total, 0.9);
   state.counters["edges_ms"] = Quantile(edges, 0.5);
   state.counters["segments_ms"] = Quantile(segments, 0.5);
+  state.counters["faces_ms"] = Quantile(faces, 0.5);  // beside the segments, own thread
   state.counters["poses_ms"] = Quantile(poses, 0.5);
   state.counters["correct"] = correct;
   state.counters["returned"] = returned;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <functional>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -114,6 +115,87 @@ class ForkJoin {
   std::atomic<int> pending_{0};
   std::atomic<long long> generation_{0};
   std::atomic<bool> stop_{false};
+};
+
+// Short parallel loops run by one thread and shared with any thread that
+// offers to help while they run (a thread done with its own stage): each
+// loop is cut into chunks claimed one at a time, by the caller and by
+// whoever helps, so a loop's result must not depend on which thread ran a
+// chunk. With no helper a loop simply runs on the caller.
+class SharedLoops {
+ public:
+  SharedLoops() = default;
+  SharedLoops(const SharedLoops&) = delete;
+  SharedLoops& operator=(const SharedLoops&) = delete;
+
+  // fn(begin, end) over [0, n) in chunks of `chunk`; returns when all are done.
+  template <typename Fn>
+  void Run(int n, int chunk, Fn&& fn) {
+    if (n <= 0) return;
+    const std::function<void(int, int)> f = std::ref(fn);
+    Loop loop{&f, n, std::max(1, chunk)};
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      loop_ = &loop;
+      ++generation_;
+    }
+    Work(loop);
+    while (loop.done.load(std::memory_order_acquire) < n) std::this_thread::yield();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      loop_ = nullptr;
+    }
+    // A helper that took the loop may still be between its last claim (which
+    // found nothing left) and letting go of it.
+    while (loop.users.load(std::memory_order_acquire) != 0) std::this_thread::yield();
+  }
+
+  // Takes chunks of the loops that Run publishes, until Close().
+  void Help() {
+    long long seen = 0;
+    while (!closed_.load(std::memory_order_acquire)) {
+      Loop* loop = nullptr;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (loop_ != nullptr && generation_ != seen) {
+          loop = loop_;
+          seen = generation_;
+          loop->users.fetch_add(1, std::memory_order_acq_rel);
+        }
+      }
+      if (loop == nullptr) {
+        std::this_thread::yield();
+        continue;
+      }
+      Work(*loop);
+      loop->users.fetch_sub(1, std::memory_order_acq_rel);
+    }
+  }
+
+  // Help returns (now, or after its current chunk).
+  void Close() { closed_.store(true, std::memory_order_release); }
+
+ private:
+  struct Loop {
+    const std::function<void(int, int)>* fn;
+    int n;
+    int chunk;
+    std::atomic<int> next{0};
+    std::atomic<int> done{0};
+    std::atomic<int> users{0};
+  };
+  static void Work(Loop& loop) {
+    for (int i = loop.next.fetch_add(loop.chunk); i < loop.n; i = loop.next.fetch_add(loop.chunk)) {
+      const int end = std::min(loop.n, i + loop.chunk);
+      (*loop.fn)(i, end);
+      loop.done.fetch_add(end - i, std::memory_order_acq_rel);
+    }
+  }
+
+  std::mutex mutex_;
+  Loop* loop_ = nullptr;  // guarded by mutex_
+  long long generation_ = 0;  // guarded by mutex_
+  std::atomic<bool> closed_{false};
 };
 
 }  // namespace cornerpose::internal
