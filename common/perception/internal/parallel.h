@@ -193,7 +193,7 @@ class SharedLoops {
   }
 
   std::mutex mutex_;
-  Loop* loop_ = nullptr;  // guarded by mutex_
+  Loop* loop_ = nullptr;      // guarded by mutex_
   long long generation_ = 0;  // guarded by mutex_
   std::atomic<bool> closed_{false};
 };
