@@ -64,8 +64,8 @@ BoxFace TopFace(const GroundTruthBox& gt) { return gt.grasp_face; }
 TEST(RefineOnGraspFaceTest, AnIsolatedBoxComesBackFromAnOffsetReadingWithFourFreeSides) {
   const FlatScene s = RenderFlat({Flat(kCartonS, 0.0, 0.0)});
   const GroundTruthBox& gt = s.rendered.boxes[0];
-  for (const auto& [dx, dy, yaw] : {std::tuple{0.0, 0.0, 0.0}, std::tuple{0.015, -0.01, 4.0},
-                                    std::tuple{-0.02, 0.012, -6.0}}) {
+  for (const auto& [dx, dy, yaw] :
+       {std::tuple{0.0, 0.0, 0.0}, std::tuple{0.015, -0.01, 4.0}, std::tuple{-0.02, 0.012, -6.0}}) {
     Eigen::Isometry3d pose = Moved(gt.camera_T_box, dx, dy, yaw);
     const RefinementResult r =
         RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), RefinementOptions{}, &pose);
@@ -100,7 +100,8 @@ TEST(RefineOnGraspFaceTest, AReadingFarOffIsNotMeasuredAsTheBox) {
 // Two cartons end to end with a 3 mm gap: the sides facing each other are
 // seams, the others free.
 TEST(RefineOnGraspFaceTest, TouchingCartonsMeetAtASeam) {
-  const FlatScene s = RenderFlat({Flat(kCartonS, 0.0, 0.0), Flat(kCartonS, kCartonS.l + 0.003, 0.0)});
+  const FlatScene s =
+      RenderFlat({Flat(kCartonS, 0.0, 0.0), Flat(kCartonS, kCartonS.l + 0.003, 0.0)});
   const GroundTruthBox& gt = s.rendered.boxes[0];
   Eigen::Isometry3d pose = Moved(gt.camera_T_box, 0.006, 0.004, 1.0);
   const RefinementResult r =
