@@ -455,9 +455,11 @@ void ColourSeamSide(const DepthImage& depth, const FaceFrame& f, bool along_a, d
 }
 
 // True when, past a side, the first surface after a run of missing returns
-// lies in front of the face's plane: the gap is the shadow of something
-// standing over the face, which may go on underneath it, so the side is not
-// where the face ends. Looks up to 8 cm out along three lines.
+// lies in front of the face's plane (the gap is the shadow of something
+// standing over the face), or the first surface right at the side lies a
+// whole box dimension above it (a box standing on the face): the face may
+// go on underneath, so the side is not where the face ends. Looks up to
+// 8 cm out along three lines.
 bool ShadowedByOccluder(const DepthImage& depth, const Eigen::Vector3d& side_centre,
                         const Eigen::Vector3d& across, const Eigen::Vector3d& along,
                         double half_along, const Eigen::Vector3d& normal, const BoxDims& dims,
