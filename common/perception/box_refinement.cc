@@ -457,21 +457,24 @@ void ColourSeamSide(const DepthImage& depth, const FaceFrame& f, bool along_a, d
 // True when, past a side, the first surface after a run of missing returns
 // lies in front of the face's plane (the gap is the shadow of something
 // standing over the face), or the first surface right at the side lies a
-// whole box dimension above it (a box standing on the face): the face may
-// go on underneath, so the side is not where the face ends. Looks up to
-// 8 cm out along three lines.
+// whole box dimension above it on all three lines (a box standing on the
+// face): the face may go on underneath, so the side is not where the face
+// ends. Looks up to 8 cm out along three lines.
 bool ShadowedByOccluder(const DepthImage& depth, const Eigen::Vector3d& side_centre,
                         const Eigen::Vector3d& across, const Eigen::Vector3d& along,
                         double half_along, const Eigen::Vector3d& normal, const BoxDims& dims,
                         const RefinementOptions& o) {
   // Right past the side (no shadow between), a surface a whole box
-  // dimension above the face is the top of a box standing on it.
+  // dimension above the face along the whole side (all three lines) is the
+  // top of a box standing on it; on one line only it is more often a
+  // neighbour in a heap whose top happens to lie that high.
   auto rests_on_face = [&](double height) {
     for (int k = 0; k < 3; ++k) {
       if (std::abs(height - dims[k]) < 0.025) return true;
     }
     return false;
   };
+  int resting = 0;  // lines on which a box stands on the face right at the side
   for (double t : {-0.6, 0.0, 0.6}) {
     const Eigen::Vector3d start = side_centre + t * half_along * along;
     for (double d = 0.004; d < 0.08; d += 0.003) {
@@ -484,11 +487,12 @@ bool ShadowedByOccluder(const DepthImage& depth, const Eigen::Vector3d& side_cen
       const float z = depth.at(u, v);
       if (std::isnan(z)) continue;
       const double height = (z * PixelRay(depth.camera, u, v) - q).dot(normal);
-      if (height > o.plane_tolerance_m && (d > 0.012 || rests_on_face(height))) return true;
+      if (height > o.plane_tolerance_m && d > 0.012) return true;
+      resting += height > o.plane_tolerance_m && rests_on_face(height);
       break;  // a surface at or behind the plane: a real end
     }
   }
-  return false;
+  return resting == 3;
 }
 
 // Where the face's plane ends beyond one side: marches outward from the
