@@ -119,8 +119,8 @@ class OrganizedScorer {
       for (int u = 0; u < w; u += lattice) {
         const int cu = u / cell_px;
         if (cells != nullptr && !(*cells)[cv * cells_w + cu]) continue;
-        const bool scored = cell_scores != nullptr && centre_row &&
-                            u == std::min(cu * cell_px + centre, w - 1);
+        const bool scored =
+            cell_scores != nullptr && centre_row && u == std::min(cu * cell_px + centre, w - 1);
         const float score = scored ? (*cell_scores)[cv * cells_w + cu] : ScoreAt(u, v);
         if (score <= options_.threshold) continue;
         const Eigen::Vector3f& p = cloud_.xyz[v * w + u];
@@ -309,10 +309,10 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
   const int step = options.coarse_step;
   const int lattice = options.lattice_px;
   if (step <= 1) {
-    internal::ParallelForChunks(cloud.height, kRowsPerBlock, options.num_threads,
-                                [&](int c, int begin, int end) {
-                                  scorer.ScoreRows(begin, end, lattice, 1, nullptr, nullptr, &chunks[c]);
-                                });
+    internal::ParallelForChunks(
+        cloud.height, kRowsPerBlock, options.num_threads, [&](int c, int begin, int end) {
+          scorer.ScoreRows(begin, end, lattice, 1, nullptr, nullptr, &chunks[c]);
+        });
     return Merge(cloud, chunks);
   }
   // Coarse to fine: edge bands are several pixels wide, so a grid of one
@@ -347,11 +347,10 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
       cells[cv * cells_w + cu] = near_hit;
     }
   }
-  internal::ParallelForChunks(cloud.height, kRowsPerBlock, options.num_threads,
-                              [&](int c, int begin, int end) {
-                                scorer.ScoreRows(begin, end, lattice, cell_px, &cells, &cell_scores,
-                                                 &chunks[c]);
-                              });
+  internal::ParallelForChunks(
+      cloud.height, kRowsPerBlock, options.num_threads, [&](int c, int begin, int end) {
+        scorer.ScoreRows(begin, end, lattice, cell_px, &cells, &cell_scores, &chunks[c]);
+      });
   return Merge(cloud, chunks);
 }
 

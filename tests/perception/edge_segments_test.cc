@@ -10,6 +10,7 @@
 #include <iostream>
 #include <numbers>
 #include <random>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -229,6 +230,17 @@ TEST(FitEdgeSegmentsTest, SameSeedSameSegments) {
   }
 }
 
+// The same segments, end for end, in the same order.
+void ExpectSameSegments(const std::vector<EdgeSegment>& a, const std::vector<EdgeSegment>& b,
+                        const std::string& label) {
+  ASSERT_EQ(a.size(), b.size()) << label;
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].end1, b[i].end1) << label;
+    EXPECT_EQ(a[i].end2, b[i].end2) << label;
+    EXPECT_EQ(a[i].num_points, b[i].num_points) << label;
+  }
+}
+
 // The RANSAC iterations run on several threads (internal::ForkJoin); what
 // they find must not depend on how many.
 TEST(FitEdgeSegmentsTest, SameSegmentsOnAnyNumberOfThreads) {
@@ -243,12 +255,7 @@ TEST(FitEdgeSegmentsTest, SameSegmentsOnAnyNumberOfThreads) {
   const auto b = FitEdgeSegments(pts, three);
   ASSERT_TRUE(a.ok() && b.ok());
   ASSERT_GE(a->size(), 8u);
-  ASSERT_EQ(a->size(), b->size());
-  for (size_t i = 0; i < a->size(); ++i) {
-    EXPECT_EQ((*a)[i].end1, (*b)[i].end1);
-    EXPECT_EQ((*a)[i].end2, (*b)[i].end2);
-    EXPECT_EQ((*a)[i].num_points, (*b)[i].num_points);
-  }
+  ExpectSameSegments(*a, *b, "3 threads");
 }
 
 // The same with the iterations on shared loops (internal::SharedLoops), as
@@ -276,12 +283,7 @@ TEST(FitEdgeSegmentsTest, SameSegmentsOnSharedLoopsWithLateAndEarlyHelpers) {
     const auto got = FitEdgeSegments(pts, one, &shared);
     shared.Close();
     ASSERT_TRUE(got.ok());
-    ASSERT_EQ(got->size(), reference->size()) << helpers << " helpers";
-    for (size_t i = 0; i < got->size(); ++i) {
-      EXPECT_EQ((*got)[i].end1, (*reference)[i].end1) << helpers << " helpers";
-      EXPECT_EQ((*got)[i].end2, (*reference)[i].end2) << helpers << " helpers";
-      EXPECT_EQ((*got)[i].num_points, (*reference)[i].num_points) << helpers << " helpers";
-    }
+    ExpectSameSegments(*reference, *got, std::to_string(helpers) + " helpers");
   }
 }
 

@@ -22,6 +22,17 @@
 namespace cornerpose::testing {
 namespace {
 
+// The error of `box` against the ground-truth box nearest to it (by
+// translation), symmetries handled.
+PoseError AgainstNearest(const DetectedBox& box, const std::vector<GroundTruthBox>& truth) {
+  PoseError nearest{1e9, 1e9};
+  for (const GroundTruthBox& gt : truth) {
+    const PoseError e = ComparePoses(box.camera_T_box, gt.camera_T_box, gt.dims);
+    if (e.translation_m < nearest.translation_m) nearest = e;
+  }
+  return nearest;
+}
+
 // Was: FindExtremities (common/perception/edge_segments.cc, the
 // `d1.dot(d2) < 0.0f` test) decides "all neighbours lie on the reference's
 // side" with full 3-D vectors. A point of a band that sits beside the
@@ -113,14 +124,8 @@ TEST(RegressionTest, NoWrongBoxOnIsolatedAndHeapScenes) {
     const absl::StatusOr<Detection> det = DetectBoxes(out.cloud, options);
     ASSERT_TRUE(det.ok()) << det.status();
     for (const DetectedBox& box : det->boxes) {
-      double nearest_m = 1e9, nearest_deg = 1e9;
-      for (const GroundTruthBox& gt : out.boxes) {
-        const PoseError e = ComparePoses(box.camera_T_box, gt.camera_T_box, c.dims);
-        if (e.translation_m < nearest_m) {
-          nearest_m = e.translation_m;
-          nearest_deg = e.rotation_deg;
-        }
-      }
+      const PoseError nearest = AgainstNearest(box, out.boxes);
+      const double nearest_m = nearest.translation_m, nearest_deg = nearest.rotation_deg;
       EXPECT_LT(nearest_m, 0.02) << (c.heap ? "heap" : "isolated") << " l=" << c.dims.l << " seed "
                                  << c.seed << ": box off by " << nearest_deg << " deg, score "
                                  << box.score << (box.from_face ? " (face proposal)" : " (corner)");
@@ -281,16 +286,11 @@ TEST(RegressionTest, NoTurnedBoxOnALowerLayerUnderAnUpperOne) {
     ASSERT_TRUE(det.ok()) << det.status();
     EXPECT_FALSE(det->boxes.empty()) << "frame " << i;
     for (const DetectedBox& b : det->boxes) {
-      double best_t = 1e9, best_r = 1e9;
-      for (const GroundTruthBox& gt : r.boxes) {
-        const PoseError e = ComparePoses(b.camera_T_box, gt.camera_T_box, gt.dims);
-        if (e.translation_m < best_t) {
-          best_t = e.translation_m;
-          best_r = e.rotation_deg;
-        }
-      }
-      EXPECT_LT(best_t, 0.02) << "frame " << i << ": a box 2 cm or more from every carton";
-      EXPECT_LT(best_r, 10.0) << "frame " << i << ": a box turned against the nearest carton";
+      const PoseError nearest = AgainstNearest(b, r.boxes);
+      EXPECT_LT(nearest.translation_m, 0.02)
+          << "frame " << i << ": a box 2 cm or more from every carton";
+      EXPECT_LT(nearest.rotation_deg, 10.0)
+          << "frame " << i << ": a box turned against the nearest carton";
     }
   }
 }
