@@ -306,127 +306,157 @@ void UseFrameCamera(const std::optional<CameraIntrinsics>& frame_camera, Detecto
   if (frame_camera) options->camera = frame_camera;
 }
 
-absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOptions& options_in) {
-  const Clock::time_point t_start = Clock::now();
+namespace {
+
+// The frame as the stages read it: the input sanitized (and an unorganized
+// single-view cloud laid onto the camera's pixel grid), its camera, its depth
+// image, and the options with what the frame's geometry derives. Not movable:
+// `work` points into it.
+struct PreparedFrame {
+  PreparedFrame() = default;
+  PreparedFrame(const PreparedFrame&) = delete;
+  PreparedFrame& operator=(const PreparedFrame&) = delete;
+
+  DetectorOptions options;
+  CameraIntrinsics camera;
+  PointCloud sanitized, projected;  // storage for `work` when it is neither the input
+  const PointCloud* work = nullptr;
+  DepthImage depth;
+  bool too_few_points = false;  // an organized frame with too few valid points to hold a box
+};
+
+// Phase 1: checks the input, sanitizes it, finds the camera and the depth
+// image, and derives the geometry parameters.
+absl::Status PrepareFrame(const PointCloud& input, const DetectorOptions& options_in,
+                          PreparedFrame* f) {
   if (absl::Status s = options_in.Validate(); !s.ok()) return s;
   if (absl::Status s = input.Validate(); !s.ok()) return s;
-  PointCloud sanitized;
-  const PointCloud& cloud = SanitizeCloud(input, &sanitized);
+  const PointCloud& cloud = SanitizeCloud(input, &f->sanitized);
   if (cloud.size() > static_cast<size_t>(options_in.max_points)) {
     return absl::InvalidArgumentError(absl::StrCat(
         "cloud has ", cloud.size(), " points, above the limit of ", options_in.max_points));
   }
-  DetectorOptions options = options_in;
+  DetectorOptions& options = f->options;
+  options = options_in;
   options.edge_points.num_threads = options.num_threads;
   // With face proposals, one thread finds the planar patches while the
-  // others fit the segments, and then helps them (below).
+  // others fit the segments, and then helps them (FindSegments).
   options.segments.num_threads = options.num_threads;
-  Detection det;
 
-  // Preprocess: the camera and its depth image.
-  CameraIntrinsics camera = options.camera.value_or(CameraIntrinsics{});
+  f->camera = options.camera.value_or(CameraIntrinsics{});
   if (cloud.organized()) {
     absl::StatusOr<CameraIntrinsics> k = EstimateIntrinsics(cloud);
-    if (!k.ok()) {  // too few valid points to hold a box
-      det.timings.total_ms = MsSince(t_start);
-      return det;
+    if (!k.ok()) {
+      f->too_few_points = true;
+      return absl::OkStatus();
     }
     if (absl::Status s = k->Validate(); !s.ok()) {
       return absl::InvalidArgumentError(
           absl::StrCat("the organized cloud's points imply implausible ", s.message()));
     }
-    camera = *k;
+    f->camera = *k;
   }
   // A single-view unorganized cloud is laid back onto the camera's pixel
   // grid, so it takes the same (fast, shadow-aware) path as a frame.
   // A cloud that is not in a camera's frame (a merged scan, an object
   // model) mostly falls outside the image: it keeps the k-d tree path.
-  PointCloud projected;
   bool project = !cloud.organized() && options.project_unorganized;
   if (project) {
-    projected = OrganizeByProjection(cloud, camera);
+    f->projected = OrganizeByProjection(cloud, f->camera);
     PointCloud in_range;  // the projected frame gets a camera's depth range
-    if (&SanitizeCloud(projected, &in_range) != &projected) projected = std::move(in_range);
+    if (&SanitizeCloud(f->projected, &in_range) != &f->projected) {
+      f->projected = std::move(in_range);
+    }
     const auto valid = [](const std::vector<Eigen::Vector3f>& xyz) {
       return std::count_if(xyz.begin(), xyz.end(), PointCloud::IsValid);
     };
-    project = 2 * valid(projected.xyz) >= valid(cloud.xyz);
+    project = 2 * valid(f->projected.xyz) >= valid(cloud.xyz);
   }
-  const PointCloud& work = project ? projected : cloud;
-  const DepthImage depth = MakeDepthImage(work, camera);
-  const double median_z = MedianDepth(depth.z);
-  if (options.parameters_from_geometry) DeriveGeometryParameters(median_z, camera.fx, &options);
+  if (project) {
+    f->work = &f->projected;
+  } else {
+    f->work = &cloud;  // the input or f->sanitized
+  }
+  f->depth = MakeDepthImage(*f->work, f->camera);
+  const double median_z = MedianDepth(f->depth.z);
+  if (options.parameters_from_geometry) DeriveGeometryParameters(median_z, f->camera.fx, &options);
   if (options.size_tolerance_m) ApplySizeTolerance(*options.size_tolerance_m, &options);
   if (options.edge_lattice_radius_px > 0.0) {
-    const double z = median_z;
-    const double radius_px = z > 0.0 ? options.edge_points.radius_m * camera.fx / z : 0.0;
+    const double radius_px =
+        median_z > 0.0 ? options.edge_points.radius_m * f->camera.fx / median_z : 0.0;
     options.edge_points.lattice_px = std::clamp(
         static_cast<int>(radius_px / options.edge_lattice_radius_px), 1, kMaxEdgeLattice);
   }
-  det.timings.preprocess_ms = MsSince(t_start);
+  return absl::OkStatus();
+}
 
+// Phase 2: the edge points, their segments and corners (the paper's
+// stages), and beside them the planar patches and their tilings.
+absl::Status FindEdgesAndFaces(const PreparedFrame& f, const CancelToken& cancel, Detection* det,
+                               SegmentGroups* groups, FaceProposals* faces) {
+  const DetectorOptions& options = f.options;
   Clock::time_point t0 = Clock::now();
-  absl::StatusOr<EdgePoints> edges = DetectEdgePoints(work, options.edge_points, camera.fx);
+  absl::StatusOr<EdgePoints> edges =
+      DetectEdgePoints(*f.work, options.edge_points, f.camera.fx, &cancel);
   if (!edges.ok()) return edges.status();
-  det.edge_points = edges->points;
-  det.timings.edge_points_ms = MsSince(t0);
+  if (absl::Status s = cancel.Check("the edge points"); !s.ok()) return s;
+  det->edge_points = edges->points;
+  det->timings.edge_points_ms = MsSince(t0);
 
   // The planar patches and their tilings need only the depth image: they
   // are found on a thread of their own while the edge points become
-  // segments and corners.
-  // (A jthread: joined on every path out, an error below returns early.)
-  // Done with them, that thread helps fit the segments (their RANSAC
-  // iterations are shared loops), so neither stage waits on the other.
-  // Beyond two threads, the others help from the start.
-  FaceProposals faces;
+  // segments and corners. Done with them, that thread helps fit the
+  // segments (their RANSAC iterations are shared loops), so neither stage
+  // waits on the other. Beyond two threads, the others help from the start.
   internal::SharedLoops shared;
   const bool share = options.face_proposals && options.num_threads > 1;
-  std::jthread faces_thread;
-  if (options.face_proposals) {
-    faces_thread = std::jthread([&] {
-      const Clock::time_point t_faces = Clock::now();
-      faces = ProposeFromFaces(depth, options.box, options.faces);
-      det.timings.faces_ms = MsSince(t_faces);
-      if (share) shared.Help();
-    });
+  {
+    std::jthread faces_thread;  // joined at the end of this block, on every path
+    if (options.face_proposals) {
+      faces_thread = std::jthread([&] {
+        const Clock::time_point t_faces = Clock::now();
+        *faces = ProposeFromFaces(f.depth, options.box, options.faces, &cancel);
+        det->timings.faces_ms = MsSince(t_faces);
+        if (share) shared.Help();
+      });
+    }
+    std::vector<std::jthread> helpers;
+    for (int t = 2; share && t < options.num_threads; ++t) {
+      helpers.emplace_back([&] { shared.Help(); });
+    }
+    t0 = Clock::now();
+    absl::StatusOr<std::vector<EdgeSegment>> segments =
+        FitEdgeSegments(det->edge_points, options.segments, share ? &shared : nullptr, &cancel);
+    shared.Close();
+    helpers.clear();  // joined
+    if (!segments.ok()) return segments.status();
+    det->segments = *std::move(segments);
+    det->timings.edge_segments_ms = MsSince(t0);
   }
-  std::vector<std::jthread> helpers;
-  for (int t = 2; share && t < options.num_threads; ++t) {
-    helpers.emplace_back([&] { shared.Help(); });
-  }
+  if (absl::Status s = cancel.Check("the edge segments and planar patches"); !s.ok()) return s;
 
   t0 = Clock::now();
-  absl::StatusOr<std::vector<EdgeSegment>> segments =
-      FitEdgeSegments(det.edge_points, options.segments, share ? &shared : nullptr);
-  shared.Close();
-  helpers.clear();  // joined
-  if (!segments.ok()) return segments.status();
-  det.segments = *std::move(segments);
-  det.timings.edge_segments_ms = MsSince(t0);
+  absl::StatusOr<SegmentGroups> clubbed = ClubSegments(det->segments, options.clubbing);
+  if (!clubbed.ok()) return clubbed.status();
+  *groups = *std::move(clubbed);
+  det->corners = groups->corners;
+  det->timings.clubbing_ms = MsSince(t0);
+  return absl::OkStatus();
+}
 
-  t0 = Clock::now();
-  absl::StatusOr<SegmentGroups> groups = ClubSegments(det.segments, options.clubbing);
-  if (!groups.ok()) return groups.status();
-  det.corners = groups->corners;
-  det.timings.clubbing_ms = MsSince(t0);
-
-  t0 = Clock::now();
-  // Corners of each segment's group, for the paper's corner refinement.
+// Phase 3: every corner proposes the poses its two edges' lengths allow,
+// refined with the other corners of its segments' group (the paper's
+// Section 3.4).
+void ProposeFromCorners(const Detection& det, const SegmentGroups& groups,
+                        const DetectorOptions& options, internal::HypothesisJudge* judge) {
   std::vector<int> group_of(det.segments.size(), -1);
-  for (size_t g = 0; g < groups->groups.size(); ++g) {
-    for (int s : groups->groups[g]) group_of[s] = static_cast<int>(g);
+  for (size_t g = 0; g < groups.groups.size(); ++g) {
+    for (int s : groups.groups[g]) group_of[s] = static_cast<int>(g);
   }
-  std::vector<std::vector<Eigen::Vector3d>> group_corners(groups->groups.size());
+  std::vector<std::vector<Eigen::Vector3d>> group_corners(groups.groups.size());
   for (const Corner& c : det.corners) {
     group_corners[group_of[c.segment_a]].push_back(c.position.cast<double>());
   }
-
-  std::vector<DeclinedCandidate> declined;
-  // Planar patches and their tilings first: every hypothesis, corner or
-  // face, is checked against the layer its face lies on.
-  if (faces_thread.joinable()) faces_thread.join();
-  internal::HypothesisJudge judge(depth, options);
-  std::vector<std::array<SideKind, 4>> sides_of;  // per det.boxes entry
   for (const Corner& c : det.corners) {
     const EdgeSegment& sa = det.segments[c.segment_a];
     const EdgeSegment& sb = det.segments[c.segment_b];
@@ -439,21 +469,33 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
       Eigen::Isometry3d pose = PoseFromCorner(p1, fa - p1, fb - p1, as, options.box);
       const int corners = 1 + RefineWithCorners(group_corners[group_of[c.segment_a]], options.box,
                                                 options.pose, &pose);
-      judge.Propose(pose, corners, {c.segment_a, c.segment_b});
+      judge->Propose(pose, corners, {c.segment_a, c.segment_b});
     }
   }
-  // Best first; a box overlapping an accepted one is the same box or a
-  // contradiction, and is dropped. Each accepted box proposes its
-  // neighbours, which are judged the same way and may propose theirs.
-  auto overlaps_kept = [&](const Eigen::Isometry3d& pose) {
-    return std::any_of(det.boxes.begin(), det.boxes.end(), [&](const DetectedBox& kept) {
-      return internal::BoxesOverlap(kept.camera_T_box, pose, options.box,
-                                    options.acceptance.overlap_margin_m);
+}
+
+// Phase 4: the judge's verdicts become boxes. Best first; a box overlapping
+// an accepted one is the same box or a contradiction, and is dropped. Each
+// accepted box proposes its neighbours, which are judged the same way and
+// may propose theirs.
+class BoxAcceptance {
+ public:
+  BoxAcceptance(const DetectorOptions& options, const CancelToken& cancel,
+                internal::HypothesisJudge* judge, Detection* det)
+      : options_(options), cancel_(cancel), judge_(judge), det_(det) {}
+
+  bool OverlapsKept(const Eigen::Isometry3d& pose) const {
+    return std::any_of(det_->boxes.begin(), det_->boxes.end(), [&](const DetectedBox& kept) {
+      return internal::BoxesOverlap(kept.camera_T_box, pose, options_.box,
+                                    options_.acceptance.overlap_margin_m);
     });
-  };
-  auto accept_all = [&] {
-    std::vector<internal::Candidate> pending = judge.Evaluate(options.num_threads);
-    while (!pending.empty()) {
+  }
+
+  // Judges what is queued, accepts, and judges what the accepted propose,
+  // until nothing is left (or the token stops).
+  void AcceptAll() {
+    std::vector<internal::Candidate> pending = judge_->Evaluate(options_.num_threads);
+    while (!pending.empty() && !cancel_.Stopped()) {
       // The reading whose face ends in more free borders goes first, then
       // the higher score: a free border is measured, a seam or a tiling is
       // inferred (two boxes on end side by side have a lying box's outline,
@@ -466,53 +508,101 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
                          return a.box.score > b.box.score;
                        });
       for (internal::Candidate& c : pending) {
-        if (overlaps_kept(c.box.camera_T_box)) continue;
-        det.boxes.push_back(c.box);
-        sides_of.push_back(c.refinement.sides);
-        if (options.propagate_to_neighbours) {
+        if (OverlapsKept(c.box.camera_T_box)) continue;
+        det_->boxes.push_back(c.box);
+        sides_of_.push_back(c.refinement.sides);
+        if (options_.propagate_to_neighbours) {
           for (const Eigen::Isometry3d& pose :
-               NeighbourHypotheses(c.box, options.box, options.neighbour_gap_m)) {
-            judge.Propose(pose, 0, {});
+               NeighbourHypotheses(c.box, options_.box, options_.neighbour_gap_m)) {
+            judge_->Propose(pose, 0, {});
           }
         }
       }
-      pending = judge.Evaluate(options.num_threads);
+      pending = judge_->Evaluate(options_.num_threads);
     }
-  };
-  accept_all();
-  // Face proposals after the corner ones: a tile on a box already found is
-  // not judged again.
-  if (options.face_proposals) {
-    for (const Eigen::Isometry3d& pose : faces.poses) {
-      if (!overlaps_kept(pose)) judge.Propose(pose, 0, {}, true);
-    }
-    for (DeclinedCandidate& d : faces.declined) {
-      d.score = MeasureBox(depth, d.camera_T_box, options.box, options.evidence).support();
-      declined.push_back(std::move(d));
-    }
-    accept_all();
-    // Plausibility checks; where they took a box out, the layers' own tiles
-    // get their turn, and what that accepts is checked again (a few rounds,
-    // then a last check with nothing proposed).
-    auto check = [&] {
-      const bool floor_removed =
-          options.floor_check &&
-          CheckFloor(depth, options, faces, &det.boxes, &sides_of, &declined);
-      const bool layer_removed =
-          options.faces.check_layer_tiling &&
-          CheckLayers(depth, options, faces, &det.boxes, &sides_of, &declined);
-      return floor_removed || layer_removed;
-    };
-    for (int round = 0; round < 3 && check(); ++round) {
-      for (const LayerTiles& layer : faces.layers) {
-        for (const Eigen::Isometry3d& tile : layer.tiles) {
-          if (!overlaps_kept(tile)) judge.Propose(tile, 0, {}, true);
-        }
-      }
-      accept_all();
-    }
-    check();
   }
+
+  // The side kinds of each det->boxes entry, for the plausibility checks.
+  std::vector<std::array<SideKind, 4>>* sides_of() { return &sides_of_; }
+
+ private:
+  const DetectorOptions& options_;
+  const CancelToken& cancel_;
+  internal::HypothesisJudge* const judge_;
+  Detection* const det_;
+  std::vector<std::array<SideKind, 4>> sides_of_;
+};
+
+// Phase 5: the face tiles (after the corner hypotheses: a tile on a box
+// already found is not judged again), then the plausibility checks; where
+// they took a box out, the layers' own tiles get their turn, and what that
+// accepts is checked again (a few rounds, then a last check with nothing
+// proposed).
+void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
+                             internal::HypothesisJudge* judge, BoxAcceptance* acceptance,
+                             Detection* det, std::vector<DeclinedCandidate>* declined) {
+  const DetectorOptions& options = f.options;
+  for (const Eigen::Isometry3d& pose : faces.poses) {
+    if (!acceptance->OverlapsKept(pose)) judge->Propose(pose, 0, {}, true);
+  }
+  for (const DeclinedCandidate& d : faces.declined) {
+    declined->push_back(d);
+    declined->back().score =
+        MeasureBox(f.depth, d.camera_T_box, options.box, options.evidence).support();
+  }
+  acceptance->AcceptAll();
+  auto check = [&] {
+    const bool floor_removed =
+        options.floor_check &&
+        CheckFloor(f.depth, options, faces, &det->boxes, acceptance->sides_of(), declined);
+    const bool layer_removed =
+        options.faces.check_layer_tiling &&
+        CheckLayers(f.depth, options, faces, &det->boxes, acceptance->sides_of(), declined);
+    return floor_removed || layer_removed;
+  };
+  for (int round = 0; round < 3 && check(); ++round) {
+    for (const LayerTiles& layer : faces.layers) {
+      for (const Eigen::Isometry3d& tile : layer.tiles) {
+        if (!acceptance->OverlapsKept(tile)) judge->Propose(tile, 0, {}, true);
+      }
+    }
+    acceptance->AcceptAll();
+  }
+  check();
+}
+
+}  // namespace
+
+absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOptions& options_in,
+                                      const CancelToken& cancel) {
+  const Clock::time_point t_start = Clock::now();
+  PreparedFrame frame;
+  if (absl::Status s = PrepareFrame(input, options_in, &frame); !s.ok()) return s;
+  Detection det;
+  if (frame.too_few_points) {
+    det.timings.total_ms = MsSince(t_start);
+    return det;
+  }
+  const DetectorOptions& options = frame.options;
+  det.timings.preprocess_ms = MsSince(t_start);
+  if (absl::Status s = cancel.Check("preprocessing"); !s.ok()) return s;
+
+  SegmentGroups groups;
+  FaceProposals faces;
+  if (absl::Status s = FindEdgesAndFaces(frame, cancel, &det, &groups, &faces); !s.ok()) {
+    return s;
+  }
+
+  const Clock::time_point t0 = Clock::now();
+  internal::HypothesisJudge judge(frame.depth, options, &cancel);
+  BoxAcceptance acceptance(options, cancel, &judge, &det);
+  ProposeFromCorners(det, groups, options, &judge);
+  acceptance.AcceptAll();
+  std::vector<DeclinedCandidate> declined;
+  if (options.face_proposals) {
+    AcceptFaceTilesAndCheck(frame, faces, &judge, &acceptance, &det, &declined);
+  }
+  if (absl::Status s = cancel.Check("the judging of hypotheses"); !s.ok()) return s;
   std::stable_sort(det.boxes.begin(), det.boxes.end(),
                    [](const DetectedBox& a, const DetectedBox& b) { return a.score > b.score; });
   det.hypotheses = judge.stats();

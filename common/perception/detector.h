@@ -10,6 +10,7 @@
 #include "common/perception/box_evidence.h"
 #include "common/perception/box_pose.h"
 #include "common/perception/box_refinement.h"
+#include "common/perception/cancel_token.h"
 #include "common/perception/clubbing.h"
 #include "common/perception/edge_points.h"
 #include "common/perception/edge_segments.h"
@@ -135,6 +136,10 @@ void DeriveGeometryParameters(double median_depth_m, double focal_px, DetectorOp
 
 // Runs the detector on one cloud. Empty, all-NaN and box-free clouds give an
 // empty Detection; malformed clouds and bad options give INVALID_ARGUMENT.
-absl::StatusOr<Detection> DetectBoxes(const PointCloud& cloud, const DetectorOptions& options);
+// When `cancel` stops (its deadline passes or its caller goes away) the
+// detection ends within a few milliseconds with DEADLINE_EXCEEDED or
+// CANCELLED: it is checked between the stages and inside their long loops.
+absl::StatusOr<Detection> DetectBoxes(const PointCloud& cloud, const DetectorOptions& options,
+                                      const CancelToken& cancel = CancelToken());
 
 }  // namespace cornerpose

@@ -300,7 +300,7 @@ EdgePoints Merge(const PointCloud& cloud, std::vector<Chunk>& chunks) {
 }
 
 EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& options,
-                           double focal_px) {
+                           double focal_px, const CancelToken* cancel) {
   const OrganizedScorer scorer(cloud, options, focal_px);
   // Blocks of rows, taken by the threads as they finish one (edge bands
   // gather in some rows), each with its own output, merged in row order.
@@ -311,6 +311,7 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
   if (step <= 1) {
     internal::ParallelForChunks(
         cloud.height, kRowsPerBlock, options.num_threads, [&](int c, int begin, int end) {
+          if (StopRequested(cancel)) return;
           scorer.ScoreRows(begin, end, lattice, 1, nullptr, nullptr, &chunks[c]);
         });
     return Merge(cloud, chunks);
@@ -326,6 +327,7 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
             cells_h = (cloud.height + cell_px - 1) / cell_px;
   std::vector<float> cell_scores(static_cast<size_t>(cells_w) * cells_h, -1.0f);
   internal::ParallelForChunks(cells_h, 4, options.num_threads, [&](int, int begin, int end) {
+    if (StopRequested(cancel)) return;
     scorer.ScoreCoarse(begin, end, cell_px, lattice, &cell_scores);
   });
   const float hit = static_cast<float>(options.threshold * options.coarse_threshold_factor);
@@ -349,6 +351,7 @@ EdgePoints DetectOrganized(const PointCloud& cloud, const EdgePointOptions& opti
   }
   internal::ParallelForChunks(
       cloud.height, kRowsPerBlock, options.num_threads, [&](int c, int begin, int end) {
+        if (StopRequested(cancel)) return;
         scorer.ScoreRows(begin, end, lattice, cell_px, &cells, &cell_scores, &chunks[c]);
       });
   return Merge(cloud, chunks);
@@ -367,7 +370,8 @@ uint64_t VoxelKey(const Eigen::Vector3f& p, double voxel) {
 }
 
 absl::StatusOr<EdgePoints> DetectUnorganized(const PointCloud& cloud,
-                                             const EdgePointOptions& options) {
+                                             const EdgePointOptions& options,
+                                             const CancelToken* cancel) {
   // Every finite point is scored, but the k-d tree holds only the first point
   // of each voxel of r_s / kKdVoxelsPerRadius: a ball of radius r_s then
   // holds at most ~(4/3) pi 8^3 = 2145 tree points however the input piles
@@ -406,6 +410,7 @@ absl::StatusOr<EdgePoints> DetectUnorganized(const PointCloud& cloud,
     std::vector<float> dist2, dz;
     const float r2 = static_cast<float>(options.radius_m * options.radius_m);
     for (int i = begin; i < end; ++i) {
+      if (i % 256 == 0 && StopRequested(cancel)) break;
       const pcl::PointXYZ q(queries[i].x(), queries[i].y(), queries[i].z());
       tree.radiusSearch(q, options.radius_m, found, dist2);
       examined[t] += static_cast<int64_t>(found.size());
@@ -493,16 +498,17 @@ float EdgeScore(const Eigen::Vector3f& p, const std::vector<Eigen::Vector3f>& ne
 }
 
 absl::StatusOr<EdgePoints> DetectEdgePoints(const PointCloud& cloud,
-                                            const EdgePointOptions& options, double focal_px) {
+                                            const EdgePointOptions& options, double focal_px,
+                                            const CancelToken* cancel) {
   if (absl::Status s = options.Validate(); !s.ok()) return s;
   if (absl::Status s = cloud.Validate(); !s.ok()) return s;
   if (cloud.organized()) {
     if (!(focal_px > 0.0 && std::isfinite(focal_px))) {
       return absl::InvalidArgumentError(absl::StrCat("focal length ", focal_px, " px is invalid"));
     }
-    return DetectOrganized(cloud, options, focal_px);
+    return DetectOrganized(cloud, options, focal_px, cancel);
   }
-  return DetectUnorganized(cloud, options);
+  return DetectUnorganized(cloud, options, cancel);
 }
 
 }  // namespace cornerpose

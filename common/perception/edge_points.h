@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "common/perception/cancel_token.h"
 #include "common/perception/types.h"
 
 namespace cornerpose {
@@ -86,9 +87,11 @@ float EdgeScore(const Eigen::Vector3f& p, const std::vector<Eigen::Vector3f>& ne
 // which EstimateIntrinsics() can recover from the cloud itself; unorganized
 // clouds use a k-d tree over the neighbours within r_s, as in the paper, but
 // at most one per voxel of r_s / 8, so that no pile of points makes the
-// search quadratic.
+// search quadratic. A stopped `cancel` ends the scoring early (the result is
+// then partial: the caller checks the token).
 absl::StatusOr<EdgePoints> DetectEdgePoints(const PointCloud& cloud,
                                             const EdgePointOptions& options,
-                                            double focal_px = 525.0);
+                                            double focal_px = 525.0,
+                                            const CancelToken* cancel = nullptr);
 
 }  // namespace cornerpose

@@ -77,7 +77,7 @@ class Grid {
 class SegmentFitter {
  public:
   SegmentFitter(const std::vector<Eigen::Vector3f>& pts, const EdgeSegmentOptions& o,
-                internal::SharedLoops* shared)
+                internal::SharedLoops* shared, const CancelToken* cancel)
       : pts_(pts),
         options_(o),
         alive_(pts.size(), 1),
@@ -85,6 +85,7 @@ class SegmentFitter {
         grid_(pts, static_cast<float>(o.sample_max_m / 2.0)),
         rng_(o.seed),
         shared_(shared),
+        cancel_(cancel),
         pool_(shared != nullptr ? 1 : o.num_threads) {}
 
   std::vector<EdgeSegment> Run() {
@@ -92,7 +93,7 @@ class SegmentFitter {
     int failures = 0;
     while (num_alive_ >= options_.min_points &&
            static_cast<int>(segments.size()) < options_.max_segments &&
-           failures < options_.max_failures) {
+           failures < options_.max_failures && !StopRequested(cancel_)) {
       std::optional<Line> line = BestHypothesis();
       if (!line) break;
       std::optional<EdgeSegment> segment = ExtractRun(*line);
@@ -318,6 +319,7 @@ class SegmentFitter {
   std::mt19937 rng_;
   std::vector<float> sx_, sy_, sz_;  // the current RANSAC subset
   internal::SharedLoops* const shared_;  // null: pool_ runs the iterations
+  const CancelToken* const cancel_;      // checked once per RANSAC round
   internal::ForkJoin pool_;
 };
 
@@ -405,9 +407,9 @@ std::pair<int, int> FindExtremities(const std::vector<Eigen::Vector3f>& points, 
 
 absl::StatusOr<std::vector<EdgeSegment>> FitEdgeSegments(
     const std::vector<Eigen::Vector3f>& edge_points, const EdgeSegmentOptions& options,
-    internal::SharedLoops* shared) {
+    internal::SharedLoops* shared, const CancelToken* cancel) {
   if (absl::Status s = options.Validate(); !s.ok()) return s;
-  SegmentFitter fitter(edge_points, options, shared);
+  SegmentFitter fitter(edge_points, options, shared, cancel);
   return fitter.Run();
 }
 

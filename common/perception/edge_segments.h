@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "common/perception/cancel_token.h"
 #include "common/perception/types.h"
 
 namespace cornerpose {
@@ -62,9 +63,11 @@ class SharedLoops;
 
 // Fits all edge segments in a set of edge points. With `shared`, the RANSAC
 // iterations run on it (the caller's thread and whichever threads help;
-// options.num_threads is then not used), with the same result.
+// options.num_threads is then not used), with the same result. A stopped
+// `cancel` ends the fitting after the current RANSAC round (the result is
+// then partial: the caller checks the token).
 absl::StatusOr<std::vector<EdgeSegment>> FitEdgeSegments(
     const std::vector<Eigen::Vector3f>& edge_points, const EdgeSegmentOptions& options,
-    internal::SharedLoops* shared = nullptr);
+    internal::SharedLoops* shared = nullptr, const CancelToken* cancel = nullptr);
 
 }  // namespace cornerpose

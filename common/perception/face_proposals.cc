@@ -186,7 +186,7 @@ double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const Fa
 }
 
 FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
-                               const FaceProposalOptions& o) {
+                               const FaceProposalOptions& o, const CancelToken* cancel) {
   FaceProposals out;
   out.patches = SegmentPlanarPatches(image, o.patches);
   const PlanarPatches& patches = out.patches;
@@ -195,7 +195,7 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
   std::sort(sorted.begin(), sorted.end());
   const double smallest_face = sorted[0] * sorted[1];
   const double cos_view = std::cos(o.max_view_angle_deg * std::numbers::pi / 180.0);
-  for (size_t id = 0; id < patches.patches.size(); ++id) {
+  for (size_t id = 0; id < patches.patches.size() && !StopRequested(cancel); ++id) {
     const PlanarPatch& patch = patches.patches[id];
     const double cell_m = patch.centroid.z() / image.camera.fx * patches.step_px;
     const double area = patch.points.size() * cell_m * cell_m;

@@ -16,6 +16,7 @@
 
 #include "absl/status/status.h"
 #include "common/perception/camera_model.h"
+#include "common/perception/cancel_token.h"
 #include "common/perception/planar_patches.h"
 #include "common/perception/seam_cues.h"
 #include "common/perception/types.h"
@@ -108,8 +109,10 @@ struct FaceProposals {
   std::vector<LayerTiles> layers;
 };
 
+// A stopped `cancel` (may be null) ends the tiling early, with what it has.
 FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
-                               const FaceProposalOptions& options);
+                               const FaceProposalOptions& options,
+                               const CancelToken* cancel = nullptr);
 
 // The layer (an index into faces.layers) a grasp face (centre and outward
 // normal, camera frame) lies on: on its patch, facing its way, on its plane,

@@ -103,7 +103,10 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, absl::Time deadline
   }
   if (grpc::Status s = CheckStillWanted(context, deadline); !s.ok()) return s;
 
-  absl::StatusOr<Detection> detection = DetectBoxes(*cloud, *options);
+  // The detector itself stops when the deadline passes or the caller goes
+  // away, so an abandoned call frees its worker within milliseconds.
+  const CancelToken cancel(deadline, [&context] { return context.IsCancelled(); });
+  absl::StatusOr<Detection> detection = DetectBoxes(*cloud, *options, cancel);
   if (!detection.ok()) return ToGrpcStatus(detection.status());
 
   if (grpc::Status s = CheckStillWanted(context, deadline); !s.ok()) return s;

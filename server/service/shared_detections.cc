@@ -33,8 +33,12 @@ std::shared_ptr<const SharedDetection> SharedDetections::Get(const std::string& 
   }
   // The task holds the frame and options, not the entry, so an entry every
   // stream dropped still expires.
-  pool->Submit([promise, frame = entry->frame, opts = entry->options] {
-    promise->set_value(DetectBoxes(frame->cloud, opts));
+  // A detection whose entry every stream dropped stops (its result would go
+  // to no one).
+  pool->Submit([promise, frame = entry->frame, opts = entry->options,
+                wanted = std::weak_ptr<SharedDetection>(entry)] {
+    const CancelToken cancel(absl::InfiniteFuture(), [&wanted] { return wanted.expired(); });
+    promise->set_value(DetectBoxes(frame->cloud, opts, cancel));
   });
   return entry;
 }

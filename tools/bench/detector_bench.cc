@@ -15,9 +15,11 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "common/box/box_models.h"
@@ -242,6 +244,52 @@ BENCHMARK(BM_ClutterSet)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(3.0);
+
+// How soon a cancelled detection returns: each clutter frame is detected
+// and cancelled from another thread after a delay spread over the frame's
+// detection time (1/16 ... 15/16 of it); the counters are the latencies
+// from Cancel() to DetectBoxes returning (the issue 11 aim: ~50 ms).
+void BM_CancelLatency(benchmark::State& state) {
+  const std::vector<Frame>& frames = ClutterSet();
+  std::vector<double> latency;
+  int stopped = 0, finished = 0;
+  for (auto _ : state) {
+    for (const Frame& f : frames) {
+      DetectorOptions o;
+      o.box = f.dims;
+      o.num_threads = 2;
+      const absl::StatusOr<Detection> full = DetectBoxes(f.cloud, o);
+      const double full_ms = full.ok() ? full->timings.total_ms : 0.0;
+      for (int k = 1; k < 16; k += 2) {
+        const CancelToken token;
+        std::chrono::steady_clock::time_point cancelled_at;
+        std::thread canceller([&] {
+          std::this_thread::sleep_for(
+              std::chrono::microseconds(static_cast<int64_t>(1000.0 * full_ms * k / 16.0)));
+          cancelled_at = std::chrono::steady_clock::now();
+          token.Cancel();
+        });
+        const absl::StatusOr<Detection> d = DetectBoxes(f.cloud, o, token);
+        const auto returned_at = std::chrono::steady_clock::now();
+        canceller.join();
+        if (d.ok()) {
+          ++finished;  // ended before the cancel
+          continue;
+        }
+        ++stopped;
+        latency.push_back(std::max(
+            0.0, std::chrono::duration<double, std::milli>(returned_at - cancelled_at).count()));
+      }
+    }
+  }
+  state.counters["stopped"] = stopped;
+  state.counters["finished"] = finished;
+  state.counters["median_ms"] = Quantile(latency, 0.5);
+  state.counters["p99_ms"] = Quantile(latency, 0.99);
+  state.counters["max_ms"] =
+      latency.empty() ? 0.0 : *std::max_element(latency.begin(), latency.end());
+}
+BENCHMARK(BM_CancelLatency)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 
 }  // namespace
 }  // namespace cornerpose

@@ -89,8 +89,9 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
                     0.0, 1.0);
 }
 
-HypothesisJudge::HypothesisJudge(const DepthImage& depth, const DetectorOptions& options)
-    : depth_(depth), options_(options), symmetries_(BoxSymmetries(options.box)) {}
+HypothesisJudge::HypothesisJudge(const DepthImage& depth, const DetectorOptions& options,
+                                 const CancelToken* cancel)
+    : depth_(depth), options_(options), symmetries_(BoxSymmetries(options.box)), cancel_(cancel) {}
 
 void HypothesisJudge::Propose(const Eigen::Isometry3d& camera_T_box, int corners,
                               std::vector<int> segments, bool from_face) {
@@ -108,6 +109,7 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
   // Work is uneven (most hypotheses fail the first check), so threads take
   // the next hypothesis when done with one.
   ParallelForChunks(n, 1, threads, [&](int, int i, int) {
+    if (StopRequested(cancel_)) return;
     bool r = false;
     accepted[i] = EvaluateOne(queue_[i], &results[i], &r, &reasons[i]);
     refined[i] = r;

@@ -10,6 +10,7 @@
 #include "common/perception/box_evidence.h"
 #include "common/perception/box_refinement.h"
 #include "common/perception/camera_model.h"
+#include "common/perception/cancel_token.h"
 #include "common/perception/detector.h"
 #include "common/perception/types.h"
 
@@ -29,7 +30,9 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
 
 class HypothesisJudge {
  public:
-  HypothesisJudge(const DepthImage& depth, const DetectorOptions& options);
+  // A stopped `cancel` (may be null) leaves the rest of a queue unjudged.
+  HypothesisJudge(const DepthImage& depth, const DetectorOptions& options,
+                  const CancelToken* cancel = nullptr);
 
   // Queues a pose unless one like it (same place within 1 cm, same
   // orientation up to the box's symmetries) was proposed before: the
@@ -63,6 +66,7 @@ class HypothesisJudge {
   const DepthImage& depth_;
   const DetectorOptions& options_;
   const std::vector<Eigen::Matrix3d> symmetries_;
+  const CancelToken* const cancel_;
   std::vector<Eigen::Isometry3d> seen_;
   std::vector<Proposal> queue_;
   HypothesisStats stats_;
