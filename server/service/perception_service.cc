@@ -118,13 +118,10 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, absl::Time deadline
 
 }  // namespace
 
-PerceptionServiceImpl::PerceptionServiceImpl(DetectionPool* pool, DetectorOptions defaults,
+PerceptionServiceImpl::PerceptionServiceImpl(DetectionPool* pool, const DetectorOptions& defaults,
                                              std::vector<std::unique_ptr<FrameSource>> sources,
                                              BoxModels box_models, ServiceLimits limits)
-    : pool_(pool),
-      defaults_(std::move(defaults)),
-      box_models_(std::move(box_models)),
-      limits_(limits) {
+    : pool_(pool), defaults_(defaults), box_models_(std::move(box_models)), limits_(limits) {
   for (std::unique_ptr<FrameSource>& source : sources) {
     const std::string name = source->name();
     sources_.emplace(name, std::move(source));

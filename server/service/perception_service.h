@@ -34,7 +34,7 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
   // starts from; its box is ignored. `box_models` are the server's own named
   // box sizes (before the built-in ones). `sources` (unique names) are what
   // requests can name; the service owns them, so they stop after the server.
-  PerceptionServiceImpl(DetectionPool* pool, DetectorOptions defaults,
+  PerceptionServiceImpl(DetectionPool* pool, const DetectorOptions& defaults,
                         std::vector<std::unique_ptr<FrameSource>> sources = {},
                         BoxModels box_models = {}, ServiceLimits limits = {});
 

@@ -65,7 +65,8 @@ ServerTlsFiles MutualTls() {
 }
 
 ClientTlsFiles ClientOf(const fs::path& dir, bool with_cert = true) {
-  ClientTlsFiles files{.ca = In(Certs().good, "ca.pem")};
+  ClientTlsFiles files;
+  files.ca = In(Certs().good, "ca.pem");
   if (with_cert) {
     files.cert = In(dir, "client.pem");
     files.key = In(dir, "client.key");
@@ -142,13 +143,16 @@ TEST(ServerTlsTest, MutualTlsServesAValidClientCertificateOnly) {
 
 TEST(ServerTlsTest, TlsWithoutClientCaChecksTheServerOnly) {
   const fs::path& d = Certs().good;
-  std::unique_ptr<RunningServer> server =
-      StartTls({.cert = In(d, "server.pem"), .key = In(d, "server.key")});
+  ServerTlsFiles server_only;  // no client_ca: client certificates not asked for
+  server_only.cert = In(d, "server.pem");
+  server_only.key = In(d, "server.key");
+  std::unique_ptr<RunningServer> server = StartTls(server_only);
   ASSERT_NE(server, nullptr);
   grpc::Status s = DetectEmpty(Channel(server->port(), ClientOf(d, /*with_cert=*/false)));
   EXPECT_TRUE(s.ok()) << s.error_message();
   // A client that trusts another CA refuses this server.
-  ClientTlsFiles wrong_ca{.ca = In(Certs().other, "ca.pem")};
+  ClientTlsFiles wrong_ca;
+  wrong_ca.ca = In(Certs().other, "ca.pem");
   s = DetectEmpty(Channel(server->port(), wrong_ca));
   EXPECT_EQ(s.error_code(), grpc::StatusCode::UNAVAILABLE) << s.error_message();
 }
