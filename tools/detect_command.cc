@@ -61,6 +61,9 @@ constexpr char kHelp[] =
     "                       of its tiles (true)\n"
     "  --floor_check BOOL   no box reaches through the floor, the farthest large plane\n"
     "                       (true)\n"
+    "  --layer_plane DEG    boxes side by side on one plane (a layer) take the plane\n"
+    "                       fitted through all their faces when within DEG of it (8;\n"
+    "                       0: every box keeps its own face's plane)\n"
     "  --tile_uncued BOOL   a face that runs on flat with no seam anywhere is a tile of\n"
     "                       its layer when the layer tiles (false: a laptop lid is not\n"
     "                       boxes; true for cells that see only layers of known boxes)\n"
@@ -98,6 +101,7 @@ absl::Status Run(const CommandArgs& args) {
                          args.SetBool("faces", &options.face_proposals),
                          args.SetBool("layer_check", &options.faces.check_layer_tiling),
                          args.SetBool("floor_check", &options.floor_check),
+                         args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
                          args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides)}) {
     if (!s.ok()) return s;
   }
@@ -187,6 +191,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "faces",
                                                        "layer_check",
                                                        "floor_check",
+                                                       "layer_plane",
                                                        "tile_uncued",
                                                        "size_tolerance"},
                                                       {"quiet", "kdtree"});

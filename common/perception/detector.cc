@@ -261,9 +261,9 @@ absl::Status AcceptanceOptions::Validate() const {
 
 absl::Status DetectorOptions::Validate() const {
   if (absl::Status s = box.Validate(); !s.ok()) return s;
-  for (absl::Status s :
-       {edge_points.Validate(), segments.Validate(), clubbing.Validate(), pose.Validate(),
-        refinement.Validate(), evidence.Validate(), acceptance.Validate(), faces.Validate()}) {
+  for (absl::Status s : {edge_points.Validate(), segments.Validate(), clubbing.Validate(),
+                         pose.Validate(), refinement.Validate(), evidence.Validate(),
+                         acceptance.Validate(), faces.Validate(), layer_plane.Validate()}) {
     if (!s.ok()) return s;
   }
   if (!(floor_tolerance_m > 0.0 && floor_tolerance_m <= 0.5)) {
@@ -602,6 +602,7 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   if (options.face_proposals) {
     AcceptFaceTilesAndCheck(frame, faces, &judge, &acceptance, &det, &declined);
   }
+  AlignToLayerPlanes(frame.depth, options.box, options.layer_plane, &det.boxes);
   if (absl::Status s = cancel.Check("the judging of hypotheses"); !s.ok()) return s;
   std::stable_sort(det.boxes.begin(), det.boxes.end(),
                    [](const DetectedBox& a, const DetectedBox& b) { return a.score > b.score; });

@@ -15,6 +15,7 @@
 #include "common/perception/edge_points.h"
 #include "common/perception/edge_segments.h"
 #include "common/perception/face_proposals.h"
+#include "common/perception/layer_plane.h"
 #include "common/perception/types.h"
 
 namespace cornerpose {
@@ -75,6 +76,10 @@ struct DetectorOptions {
   // three of the box's largest faces) the camera sees (detector.cc,
   // CheckFloor). Metres, square metres.
   bool floor_check = true;
+  // Returned boxes side by side on one plane (a pallet layer) take the
+  // plane fitted through all their faces (layer_plane.h; max_angle_deg 0
+  // turns it off).
+  LayerPlaneOptions layer_plane;
   double floor_tolerance_m = 0.03;
   double floor_min_area_m2 = 0.25;
   // How far a real box may be off its nominal size (bulge, sag, crushed

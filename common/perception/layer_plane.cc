@@ -1,0 +1,138 @@
+#include "common/perception/layer_plane.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+
+#include "common/validation/range_check.h"
+
+namespace cornerpose {
+namespace {
+
+// A grasp face in the camera frame.
+struct Face {
+  Eigen::Vector3d c, n, a, b;  // centre, outward normal, in-plane axes (unit)
+  double half_a = 0.0, half_b = 0.0;
+};
+
+Face FaceOf(const DetectedBox& box, const BoxDims& dims) {
+  const int fi = static_cast<int>(box.grasp_face);
+  const int axis_n = fi / 2, axis_a = (axis_n + 1) % 3, axis_b = (axis_n + 2) % 3;
+  Face f;
+  f.c = box.grasp_centre_camera;
+  f.n = box.grasp_normal_camera.normalized();
+  f.a = box.camera_T_box.linear().col(axis_a);
+  f.b = box.camera_T_box.linear().col(axis_b);
+  f.half_a = dims[axis_a] / 2.0;
+  f.half_b = dims[axis_b] / 2.0;
+  return f;
+}
+
+int Root(std::vector<int>& parent, int i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
+// Adds the face's measured points that lie on its plane, more than
+// side_margin inside its sides, to the sums.
+void AddFacePixels(const DepthImage& depth, const Face& f, const LayerPlaneOptions& o, double* n,
+                   Eigen::Vector3d* sum, Eigen::Matrix3d* sum_outer) {
+  const double in_a = f.half_a - o.side_margin_m, in_b = f.half_b - o.side_margin_m;
+  if (in_a <= 0.0 || in_b <= 0.0) return;
+  std::vector<Eigen::Vector3d> outline;
+  for (double sa : {-1.0, 1.0}) {
+    for (double sb : {-1.0, 1.0}) outline.push_back(f.c + sa * in_a * f.a + sb * in_b * f.b);
+  }
+  const std::optional<PixelRect> rect = ProjectedRect(depth.camera, outline);
+  if (!rect) return;
+  for (int v = rect->v0; v <= rect->v1; ++v) {
+    for (int u = rect->u0; u <= rect->u1; ++u) {
+      const float z = depth.at(u, v);
+      if (std::isnan(z)) continue;
+      const Eigen::Vector3d p = z * PixelRay(depth.camera, u, v);
+      const Eigen::Vector3d d = p - f.c;
+      if (std::abs(d.dot(f.a)) > in_a || std::abs(d.dot(f.b)) > in_b ||
+          std::abs(d.dot(f.n)) > o.plane_tolerance_m) {
+        continue;
+      }
+      *n += 1.0;
+      *sum += p;
+      *sum_outer += p * p.transpose();
+    }
+  }
+}
+
+}  // namespace
+
+absl::Status LayerPlaneOptions::Validate() const {
+  for (absl::Status s : {CheckRange("layer_plane.max_angle_deg", max_angle_deg, 0.0, 30.0),
+                         CheckPositive("layer_plane.plane_tolerance_m", plane_tolerance_m, 0.1),
+                         CheckPositive("layer_plane.touch_factor", touch_factor, 2.0),
+                         CheckRange("layer_plane.side_margin_m", side_margin_m, 0.0, 0.1)}) {
+    if (!s.ok()) return s;
+  }
+  return absl::OkStatus();
+}
+
+int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
+                       const LayerPlaneOptions& options, std::vector<DetectedBox>* boxes) {
+  const int n = static_cast<int>(boxes->size());
+  if (options.max_angle_deg <= 0.0 || n < 2) return 0;
+  const double cos_max = std::cos(options.max_angle_deg * std::numbers::pi / 180.0);
+  std::vector<Face> faces;
+  faces.reserve(n);
+  for (const DetectedBox& box : *boxes) faces.push_back(FaceOf(box, dims));
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      const Face &fi = faces[i], &fj = faces[j];
+      const double reach = options.touch_factor *
+                           (std::hypot(fi.half_a, fi.half_b) + std::hypot(fj.half_a, fj.half_b));
+      if (fi.n.dot(fj.n) < cos_max || (fi.c - fj.c).norm() > reach ||
+          std::abs((fj.c - fi.c).dot(fi.n)) > options.plane_tolerance_m ||
+          std::abs((fi.c - fj.c).dot(fj.n)) > options.plane_tolerance_m) {
+        continue;
+      }
+      parent[Root(parent, i)] = Root(parent, j);
+    }
+  }
+  int turned = 0;
+  for (int root = 0; root < n; ++root) {
+    if (Root(parent, root) != root) continue;
+    std::vector<int> members;
+    for (int i = 0; i < n; ++i) {
+      if (Root(parent, i) == root) members.push_back(i);
+    }
+    if (members.size() < 2) continue;
+    double count = 0.0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
+    for (int i : members) AddFacePixels(depth, faces[i], options, &count, &sum, &sum_outer);
+    if (count < 30.0) continue;
+    const Eigen::Vector3d mean = sum / count;
+    const Eigen::Matrix3d cov = sum_outer / count - mean * mean.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    Eigen::Vector3d normal = eig.eigenvectors().col(0);
+    for (int i : members) {
+      DetectedBox& box = (*boxes)[i];
+      const Eigen::Vector3d to = normal.dot(faces[i].n) < 0.0 ? -normal : normal;
+      if (to.dot(faces[i].n) < cos_max) continue;
+      // The smallest rotation taking the face's normal onto the plane's,
+      // about the face centre.
+      const Eigen::Matrix3d turn =
+          Eigen::Quaterniond::FromTwoVectors(faces[i].n, to).toRotationMatrix();
+      const int axis = static_cast<int>(box.grasp_face) / 2;
+      box.camera_T_box.linear() = turn * box.camera_T_box.linear();
+      box.camera_T_box.translation() = box.grasp_centre_camera - to * dims[axis] / 2.0;
+      box.grasp_normal_camera = to;
+      ++turned;
+    }
+  }
+  return turned;
+}
+
+}  // namespace cornerpose

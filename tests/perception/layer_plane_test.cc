@@ -1,0 +1,152 @@
+// Shared layer planes (AlignToLayerPlanes): boxes side by side on one plane
+// take the plane fitted through all their faces; a box alone, one tilted
+// beyond max_angle_deg, or one standing higher keeps its own. Exact depth
+// from the test generator, so the fitted plane is the true one.
+#include "common/perception/layer_plane.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "common/perception/camera_model.h"
+#include "tests/support/scene_generator.h"
+
+namespace cornerpose::testing {
+namespace {
+
+constexpr BoxDims kBrick{0.19, 0.09, 0.057};
+
+SceneBox Flat(double x, double y, double z_bottom = 0.0) {
+  SceneBox b;
+  b.dims = kBrick;
+  b.world_T_box.translation() = Eigen::Vector3d(x, y, z_bottom + kBrick.h / 2.0);
+  return b;
+}
+
+struct Layer {
+  RenderedScene rendered;
+  DepthImage depth;
+};
+
+// A 2 x 3 layer of touching bricks (and `extra` beside it), seen from 1.5 m,
+// the camera tilted and turned off the grid.
+Layer RenderLayer(std::vector<SceneBox> extra = {}) {
+  Scene scene;
+  for (int i = 0; i < 2; ++i) {
+    for (int j = 0; j < 3; ++j) scene.boxes.push_back(Flat(i * kBrick.l, j * kBrick.b));
+  }
+  for (const SceneBox& b : extra) scene.boxes.push_back(b);
+  scene.camera = CameraIntrinsics{};
+  scene.world_T_camera =
+      LookAtCamera(Eigen::Vector3d(kBrick.l / 2, kBrick.b, 0.0), 1.5, 10.0, 20.0, 0.0);
+  NoiseOptions exact;
+  exact.enabled = false;
+  Layer l;
+  l.rendered = Render(scene, exact);
+  l.depth = MakeDepthImage(l.rendered.cloud, l.rendered.camera);
+  return l;
+}
+
+double Deg(double rad) { return rad * 180.0 / std::numbers::pi; }
+
+// The box as the detector returns it, its face turned by `tilt_deg` about
+// an in-plane axis at `dir_deg` (about its face centre).
+DetectedBox Returned(const GroundTruthBox& gt, double tilt_deg, double dir_deg) {
+  DetectedBox box;
+  box.grasp_face = gt.grasp_face;
+  const int axis = static_cast<int>(gt.grasp_face) / 2;
+  const double sign = static_cast<int>(gt.grasp_face) % 2 == 0 ? 1.0 : -1.0;
+  const Eigen::Vector3d n = sign * gt.camera_T_box.linear().col(axis);
+  const Eigen::Vector3d centre =
+      gt.camera_T_box * (sign * Eigen::Vector3d::Unit(axis) * kBrick[axis] / 2.0);
+  const Eigen::Vector3d in_plane =
+      std::cos(dir_deg * std::numbers::pi / 180.0) * gt.camera_T_box.linear().col((axis + 1) % 3) +
+      std::sin(dir_deg * std::numbers::pi / 180.0) * gt.camera_T_box.linear().col((axis + 2) % 3);
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(tilt_deg * std::numbers::pi / 180.0, in_plane).toRotationMatrix();
+  box.camera_T_box.linear() = turn * gt.camera_T_box.linear();
+  box.grasp_normal_camera = turn * n;
+  box.grasp_centre_camera = centre;
+  box.camera_T_box.translation() = centre - box.grasp_normal_camera * kBrick[axis] / 2.0;
+  return box;
+}
+
+Eigen::Vector3d TrueNormal(const GroundTruthBox& gt) {
+  const int axis = static_cast<int>(gt.grasp_face) / 2;
+  const double sign = static_cast<int>(gt.grasp_face) % 2 == 0 ? 1.0 : -1.0;
+  return sign * gt.camera_T_box.linear().col(axis);
+}
+
+TEST(LayerPlaneTest, BoxesSideBySideTakeTheLayersPlane) {
+  const Layer l = RenderLayer();
+  std::vector<DetectedBox> boxes;
+  for (size_t i = 0; i < 6; ++i) {
+    boxes.push_back(Returned(l.rendered.boxes[i], 3.0 + 0.5 * i, 60.0 * i));
+  }
+  const std::vector<DetectedBox> before = boxes;
+  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 6);
+  for (size_t i = 0; i < 6; ++i) {
+    const Eigen::Vector3d n = TrueNormal(l.rendered.boxes[i]);
+    EXPECT_LT(Deg(std::acos(std::min(1.0, boxes[i].grasp_normal_camera.dot(n)))), 0.3) << i;
+    // The whole pose turned with the normal (the box's own axis is it), about
+    // the face centre; the in-plane turn stays the box's own.
+    const int axis = static_cast<int>(boxes[i].grasp_face) / 2;
+    EXPECT_LT((boxes[i].camera_T_box.linear().col(axis) - n).norm(), 0.01) << i;
+    EXPECT_LT((boxes[i].camera_T_box * (Eigen::Vector3d::Unit(axis) * kBrick[axis] / 2.0) -
+               before[i].grasp_centre_camera)
+                  .norm(),
+              1e-9)
+        << i;
+    EXPECT_EQ(boxes[i].grasp_centre_camera, before[i].grasp_centre_camera);
+  }
+}
+
+TEST(LayerPlaneTest, ABoxAloneOrTurnedOffTheLayerKeepsItsOwnPlane) {
+  const Layer l = RenderLayer();
+  // Alone: nothing to share.
+  std::vector<DetectedBox> one = {Returned(l.rendered.boxes[0], 4.0, 0.0)};
+  const DetectedBox alone = one[0];
+  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &one), 0);
+  EXPECT_TRUE(one[0].camera_T_box.isApprox(alone.camera_T_box));
+  // Three boxes of the layer and one tilted by 15 degrees: that one keeps
+  // its own plane, the others take the layer's.
+  std::vector<DetectedBox> boxes;
+  for (size_t i = 0; i < 3; ++i) boxes.push_back(Returned(l.rendered.boxes[i], 2.0, 90.0 * i));
+  boxes.push_back(Returned(l.rendered.boxes[3], 15.0, 30.0));
+  const DetectedBox askew = boxes[3];
+  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 3);
+  EXPECT_TRUE(boxes[3].camera_T_box.isApprox(askew.camera_T_box));
+  // Off: nothing turns.
+  LayerPlaneOptions off;
+  off.max_angle_deg = 0.0;
+  std::vector<DetectedBox> again = {Returned(l.rendered.boxes[0], 2.0, 0.0),
+                                    Returned(l.rendered.boxes[1], 2.0, 90.0)};
+  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, off, &again), 0);
+}
+
+TEST(LayerPlaneTest, ABoxOnTopOfTheLayerIsNotOnItsPlane) {
+  // A brick lying on the layer's first brick: touching in the image, a
+  // brick's height nearer the camera.
+  const Layer l = RenderLayer({Flat(0.0, 0.0, kBrick.h)});
+  ASSERT_EQ(l.rendered.boxes.size(), 7u);
+  std::vector<DetectedBox> boxes = {Returned(l.rendered.boxes[6], 3.0, 0.0),
+                                    Returned(l.rendered.boxes[1], 3.0, 120.0)};
+  const std::vector<DetectedBox> before = boxes;
+  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 0);
+  EXPECT_TRUE(boxes[0].camera_T_box.isApprox(before[0].camera_T_box));
+}
+
+TEST(LayerPlaneTest, ValidateNamesTheField) {
+  LayerPlaneOptions o;
+  EXPECT_TRUE(o.Validate().ok());
+  o.max_angle_deg = 45.0;
+  EXPECT_NE(o.Validate().message().find("layer_plane.max_angle_deg"), std::string::npos);
+  o = LayerPlaneOptions();
+  o.plane_tolerance_m = 0.0;
+  EXPECT_NE(o.Validate().message().find("layer_plane.plane_tolerance_m"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cornerpose::testing
