@@ -62,7 +62,7 @@ constexpr char kHelp[] =
     "  --floor_check BOOL   no box reaches through the floor, the farthest large plane\n"
     "                       (true)\n"
     "  --layer_plane DEG    boxes side by side on one plane (a layer) take the plane\n"
-    "                       fitted through all their faces when within DEG of it (8;\n"
+    "                       fitted through all their faces when within DEG of it (12;\n"
     "                       0: every box keeps its own face's plane)\n"
     "  --tile_uncued BOOL   a face that runs on flat with no seam anywhere is a tile of\n"
     "                       its layer when the layer tiles (false: a laptop lid is not\n"

@@ -31,6 +31,17 @@ Face FaceOf(const DetectedBox& box, const BoxDims& dims) {
   return f;
 }
 
+// The variance of the points (count, sums, sums of products) about their
+// best plane, and that plane's normal.
+double SmallestVariance(double count, const Eigen::Vector3d& sum, const Eigen::Matrix3d& sum_outer,
+                        Eigen::Vector3d* normal) {
+  const Eigen::Vector3d mean = sum / count;
+  const Eigen::Matrix3d cov = sum_outer / count - mean * mean.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  if (normal != nullptr) *normal = eig.eigenvectors().col(0);
+  return std::max(0.0, eig.eigenvalues()(0));
+}
+
 int Root(std::vector<int>& parent, int i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];
   return i;
@@ -71,7 +82,8 @@ absl::Status LayerPlaneOptions::Validate() const {
   for (absl::Status s : {CheckRange("layer_plane.max_angle_deg", max_angle_deg, 0.0, 30.0),
                          CheckPositive("layer_plane.plane_tolerance_m", plane_tolerance_m, 0.1),
                          CheckPositive("layer_plane.touch_factor", touch_factor, 2.0),
-                         CheckRange("layer_plane.side_margin_m", side_margin_m, 0.0, 0.1)}) {
+                         CheckRange("layer_plane.side_margin_m", side_margin_m, 0.0, 0.1),
+                         CheckRange("layer_plane.max_rms_ratio", max_rms_ratio, 1.0, 10.0)}) {
     if (!s.ok()) return s;
   }
   return absl::OkStatus();
@@ -108,15 +120,28 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
       if (Root(parent, i) == root) members.push_back(i);
     }
     if (members.size() < 2) continue;
-    double count = 0.0;
+    // Each face's pixels alone and all together: one plane must fit them
+    // all about as well as each face's own (two faces tilted against each
+    // other, a roof in a heap, do not share a plane).
+    double count = 0.0, own_sq = 0.0;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
-    for (int i : members) AddFacePixels(depth, faces[i], options, &count, &sum, &sum_outer);
-    if (count < 30.0) continue;
-    const Eigen::Vector3d mean = sum / count;
-    const Eigen::Matrix3d cov = sum_outer / count - mean * mean.transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    Eigen::Vector3d normal = eig.eigenvectors().col(0);
+    for (int i : members) {
+      double c = 0.0;
+      Eigen::Vector3d s1 = Eigen::Vector3d::Zero();
+      Eigen::Matrix3d s2 = Eigen::Matrix3d::Zero();
+      AddFacePixels(depth, faces[i], options, &c, &s1, &s2);
+      if (c < 30.0) continue;
+      own_sq += c * SmallestVariance(c, s1, s2, nullptr);
+      count += c;
+      sum += s1;
+      sum_outer += s2;
+    }
+    if (count < 60.0) continue;
+    Eigen::Vector3d normal;
+    const double joint_sq = SmallestVariance(count, sum, sum_outer, &normal);
+    const double own_rms = std::sqrt(own_sq / count);
+    if (std::sqrt(joint_sq) > options.max_rms_ratio * own_rms + 0.001) continue;
     for (int i : members) {
       DetectedBox& box = (*boxes)[i];
       const Eigen::Vector3d to = normal.dot(faces[i].n) < 0.0 ? -normal : normal;

@@ -1,11 +1,12 @@
 // Boxes side by side on one layer share its plane. A box's grasp face is
 // fitted from its own pixels alone, and on an active-stereo camera the depth
 // noise is correlated over blobs of ~10 pixels, so a brick's face 30 pixels
-// across tilts by 2-9 degrees (generated D4xx frames: rms 3-5 degrees for
+// across tilts by up to 9 degrees (generated D4xx frames: rms 3-5 degrees for
 // bricks, 1-2.5 for cartons). Returned boxes whose grasp faces touch and lie
 // in one plane (normals within max_angle_deg, each face's centre within
 // plane_tolerance_m of the other's plane) are grouped; the group's plane is
-// fitted through the interior pixels of all its faces, and each box takes
+// fitted through the interior pixels of all its faces (and must fit them
+// about as well as each face's own plane does), and each box takes
 // that plane's normal, turned about its own face centre: its in-plane turn
 // and position stay its own. A box alone, or tilted further from its
 // neighbours (a carton sitting askew on the layer), keeps its own fit.
@@ -24,7 +25,7 @@ struct LayerPlaneOptions {
   // centre lies within plane_tolerance_m of the other face's plane; the
   // group's plane is taken by a box whose own normal is within this of it.
   // Degrees, [0, 30]; 0 turns the sharing off.
-  double max_angle_deg = 8.0;
+  double max_angle_deg = 12.0;
   // Metres, (0, 0.1].
   double plane_tolerance_m = 0.012;
   // Faces touch when their centres are closer than this share of the sum of
@@ -33,6 +34,10 @@ struct LayerPlaneOptions {
   // Pixels nearer a face's side than this are not fitted (borders, seams).
   // Metres, [0, 0.1].
   double side_margin_m = 0.01;
+  // A group shares a plane only when the points of all its faces lie about
+  // it within this times (plus 1 mm) the rms of each face about its own.
+  // Unitless, [1, 10].
+  double max_rms_ratio = 1.3;
 
   absl::Status Validate() const;
 };

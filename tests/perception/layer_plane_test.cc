@@ -138,6 +138,48 @@ TEST(LayerPlaneTest, ABoxOnTopOfTheLayerIsNotOnItsPlane) {
   EXPECT_TRUE(boxes[0].camera_T_box.isApprox(before[0].camera_T_box));
 }
 
+// Two bricks side by side along their short axis, turned by tilt_a and
+// tilt_b degrees about it, their returned poses exact.
+struct Pair {
+  RenderedScene rendered;
+  DepthImage depth;
+  std::vector<DetectedBox> boxes;
+};
+Pair RenderPair(double tilt_a, double tilt_b) {
+  Scene scene;
+  for (double tilt : {tilt_a, tilt_b}) {
+    SceneBox b = Flat(0.0, scene.boxes.size() * kBrick.b, 0.02);
+    b.world_T_box.linear() =
+        Eigen::AngleAxisd(tilt * std::numbers::pi / 180.0, Eigen::Vector3d::UnitY())
+            .toRotationMatrix();
+    scene.boxes.push_back(b);
+  }
+  scene.camera = CameraIntrinsics{};
+  scene.world_T_camera = LookAtCamera(Eigen::Vector3d(0.0, kBrick.b / 2, 0.0), 1.2, 5.0, 0.0, 0.0);
+  NoiseOptions exact;
+  exact.enabled = false;
+  Pair p;
+  p.rendered = Render(scene, exact);
+  p.depth = MakeDepthImage(p.rendered.cloud, p.rendered.camera);
+  p.boxes = {Returned(p.rendered.boxes[0], 0.0, 0.0), Returned(p.rendered.boxes[1], 0.0, 0.0)};
+  return p;
+}
+
+TEST(LayerPlaneTest, TwoFacesTiltedAgainstEachOtherDoNotShareAPlane) {
+  // Turned 5 degrees the opposite ways (a twist in a heap): their centres
+  // lie on each other's planes and their normals are 10 degrees apart, but
+  // no one plane fits both faces.
+  Pair twisted = RenderPair(5.0, -5.0);
+  ASSERT_GT(twisted.boxes[0].grasp_normal_camera.dot(twisted.boxes[1].grasp_normal_camera),
+            std::cos(11.0 * std::numbers::pi / 180.0));
+  const std::vector<DetectedBox> before = twisted.boxes;
+  EXPECT_EQ(AlignToLayerPlanes(twisted.depth, kBrick, LayerPlaneOptions(), &twisted.boxes), 0);
+  EXPECT_TRUE(twisted.boxes[1].camera_T_box.isApprox(before[1].camera_T_box));
+  // Turned the same way they are one plane.
+  Pair same = RenderPair(5.0, 5.0);
+  EXPECT_EQ(AlignToLayerPlanes(same.depth, kBrick, LayerPlaneOptions(), &same.boxes), 2);
+}
+
 TEST(LayerPlaneTest, ValidateNamesTheField) {
   LayerPlaneOptions o;
   EXPECT_TRUE(o.Validate().ok());
