@@ -773,12 +773,14 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
   for (int it = 0; it < std::max(1, options.iterations); ++it) {
     if (!RefineStep(depth, dims, grasp_face, options, pose, result)) return result;
   }
-  MarkShadowedSides(depth, dims, grasp_face, options, pose, result);
-  TileContinuingSides(depth, dims, grasp_face, options, pose, result);
+  // A reading that moved too far is not this box: its sides are not worth
+  // the shadow and tiling checks (a third of all refinements end here).
   const double shift = (pose.translation() - initial.translation()).norm();
   const double turn_deg = Eigen::AngleAxisd(initial.linear().transpose() * pose.linear()).angle() *
                           180.0 / std::numbers::pi;
   if (shift > options.max_shift_m || turn_deg > options.max_turn_deg) return result;
+  MarkShadowedSides(depth, dims, grasp_face, options, pose, result);
+  TileContinuingSides(depth, dims, grasp_face, options, pose, result);
   *camera_T_box = pose;
   result.ok = true;
   return result;

@@ -8,6 +8,11 @@
 #include "common/perception/pose_error.h"
 
 namespace cornerpose::internal {
+namespace {
+
+constexpr char kMovedTooFar[] = "refinement moved it too far: not this box";
+
+}  // namespace
 
 double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
                     BoxFace grasp, const AcceptanceOptions& o, std::string* reason) {
@@ -16,7 +21,7 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
     return -1.0;
   };
   if (!ev.in_front_of_camera) return reject("not in front of the camera");
-  if (!ref.ok) return reject("refinement moved it too far: not this box");
+  if (!ref.ok) return reject(kMovedTooFar);
   const FaceEvidence& g = ev.faces[static_cast<int>(grasp)];
   if (g.expected < o.min_grasp_pixels) return reject("grasp face too small in the image");
   const double grasp_occluded = static_cast<double>(g.occluded) / g.expected;
@@ -156,6 +161,12 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   cand.box.score = first.support();  // what a declined candidate reports
   cand.refinement =
       RefineOnGraspFace(depth_, options_.box, grasp, options_.refinement, &cand.box.camera_T_box);
+  // The pose did not move (the gate saw it in front of the camera): the
+  // full evidence would only confirm what JudgeRefined rejects it for.
+  if (!cand.refinement.ok) {
+    *reason = kMovedTooFar;
+    return false;
+  }
   cand.evidence = MeasureBox(depth_, cand.box.camera_T_box, options_.box, options_.evidence);
   const double score = JudgeRefined(cand.evidence, cand.refinement, options_.box, grasp,
                                     options_.acceptance, reason);
