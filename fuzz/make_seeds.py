@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the small generated seed files of fuzz/corpus (PCD, PLY, PNG).
+"""Writes the small generated seed files of fuzz/corpus (PCD, PLY, PNG, DetectRequest).
 
 Run from anywhere: python3 fuzz/make_seeds.py. The UR, URScript and
 configuration seeds are copied or hand-written, not generated here.
@@ -108,7 +108,103 @@ def pngs():
     write("depth_png_fuzzer", "grey8_2x2.png", png(2, 2, 8, 0, [b"\x10\x80", b"\x80\x10"]))
 
 
+# Protocol buffers' wire format, enough for the DetectRequest seeds (field
+# numbers from proto/cornerpose/v1/geometry.proto and perception_service.proto).
+def varint(n):
+    out = bytearray()
+    while True:
+        byte = n & 0x7F
+        n >>= 7
+        out.append(byte | (0x80 if n else 0))
+        if not n:
+            return bytes(out)
+
+
+def pb_varint(field, n):
+    return varint(field << 3) + varint(n)
+
+
+def pb_double(field, x):
+    return varint(field << 3 | 1) + struct.pack("<d", x)
+
+
+def pb_bytes(field, data):
+    return varint(field << 3 | 2) + varint(len(data)) + data
+
+
+def box_scene(width, height, fx, cx, cy):
+    """Depth in metres of a 0.30 x 0.20 x 0.15 carton on a floor 1.0 m below
+    the camera, turned 20 degrees about the view axis and off centre so that
+    two of its sides show: every ray is cast against the top face, the four
+    sides and the floor."""
+    import math
+    top, floor, x0, y0 = 0.85, 1.0, 0.06, 0.04
+    c, s = math.cos(math.radians(20)), math.sin(math.radians(20))
+    depth = []
+    for v in range(height):
+        for u in range(width):
+            # The ray (x, y, 1) in the carton's frame (turned about z).
+            rx, ry = (u - cx) / fx, (v - cy) / fx
+            x, y = c * rx + s * ry, -s * rx + c * ry
+            hits = [floor]
+            for t in (top,) + tuple(k / x for k in (x0 - 0.15, x0 + 0.15) if x) + \
+                    tuple(k / y for k in (y0 - 0.10, y0 + 0.10) if y):
+                if top - 1e-9 <= t <= floor and abs(t * x - x0) <= 0.15 + 1e-9 and \
+                        abs(t * y - y0) <= 0.10 + 1e-9:
+                    hits.append(t)
+            depth.append(min(hits))
+    return depth
+
+
+def intrinsics(width, height, fx, cx, cy):
+    return (pb_varint(1, width) + pb_varint(2, height) + pb_double(3, fx) + pb_double(4, fx) +
+            pb_double(5, cx) + pb_double(6, cy))
+
+
+def box_dims(l, b, h):
+    return pb_double(1, l) + pb_double(2, b) + pb_double(3, h)
+
+
+def detect_requests():
+    harness = "detect_request_fuzzer"
+    w, h, fx = 128, 96, 120.0
+    cx, cy = w / 2, h / 2
+    depth = box_scene(w, h, fx, cx, cy)
+    camera = pb_bytes(4, intrinsics(w, h, fx, cx, cy))
+    carton = pb_bytes(5, box_dims(0.30, 0.20, 0.15))
+    mm = b"".join(struct.pack("<H", round(z * 1000)) for z in depth)
+    image = pb_bytes(1, mm) + pb_varint(2, w) + pb_varint(3, h) + pb_varint(4, 1)
+    write(harness, "depth_mm_carton.bin", pb_bytes(2, image) + camera + carton + pb_varint(8, 1))
+    metres = b"".join(struct.pack("<f", z) for z in depth)
+    image = pb_bytes(1, metres) + pb_varint(2, w) + pb_varint(3, h) + pb_varint(4, 2)
+    grey = bytes(200 if z < 0.86 else 150 if z < 0.99 else 90 for z in depth)
+    colour = pb_bytes(1, grey) + pb_varint(2, w) + pb_varint(3, h) + pb_varint(4, 2)
+    overrides = pb_double(1, 0.02) + pb_double(3, 0.01) + pb_varint(4, 1)
+    write(harness, "depth_m_grey_overrides.bin",
+          pb_bytes(2, image) + camera + pb_bytes(6, b"carton_s") + pb_bytes(7, overrides) +
+          pb_bytes(10, colour))
+    # An organized cloud (x, y, z float32 per pixel, NaN for no return) with rgb.
+    cw, ch, cfx = 64, 48, 60.0
+    points = b""
+    rgb = b""
+    for i, z in enumerate(box_scene(cw, ch, cfx, cw / 2, ch / 2)):
+        u, v = i % cw, i // cw
+        p = (float("nan"),) * 3 if (u, v) == (3, 3) else ((u - cw / 2) / cfx * z,
+                                                          (v - ch / 2) / cfx * z, z)
+        points += struct.pack("<3f", *p)
+        rgb += bytes((0xA0, 0x80, 0x60))
+    cloud = pb_bytes(1, points) + pb_varint(2, cw) + pb_varint(3, ch) + pb_bytes(4, rgb)
+    write(harness, "organized_cloud_rgb.bin", pb_bytes(1, cloud) + carton)
+    # Unorganized, laid onto the request's camera.
+    cloud = pb_bytes(1, points[: 12 * 200]) + pb_varint(2, 200) + pb_varint(3, 1)
+    write(harness, "unorganized_cloud_camera.bin",
+          pb_bytes(1, cloud) + pb_bytes(4, intrinsics(cw, ch, cfx, cw / 2, ch / 2)) +
+          pb_bytes(6, b"brick"))
+    write(harness, "source.bin", pb_bytes(3, b"camera") + carton)
+
+
 if __name__ == "__main__":
     pcds()
     plys()
     pngs()
+    detect_requests()
