@@ -127,7 +127,13 @@ Eigen::Isometry3d SlideIn(const BoxDims& dims, const Eigen::Matrix3d& R,
                           const std::vector<Eigen::Isometry3d>& placed, std::mt19937& rng) {
   const double size = std::max(dims.l, dims.b);
   std::normal_distribution<double> spread(0.0, 0.3 * size);
-  const Eigen::Vector2d c = HeapCentre(placed) + Eigen::Vector2d(spread(rng), spread(rng));
+  // Drawn one at a time: the order in which a call's arguments are evaluated
+  // is unspecified (g++ goes right to left, clang left to right), and a scene
+  // must not depend on the compiler. Second coordinate first: the scenes g++
+  // has always made.
+  const double dy = spread(rng);
+  const double dx = spread(rng);
+  const Eigen::Vector2d c = HeapCentre(placed) + Eigen::Vector2d(dx, dy);
   double radius = 0.0;
   for (const auto& p : placed) radius = std::max(radius, (p.translation().head<2>() - c).norm());
   const double phi = Uniform(rng, 0.0, 2 * std::numbers::pi);
@@ -160,8 +166,9 @@ Eigen::Isometry3d DropOnHeap(const BoxDims& dims, const std::vector<Eigen::Isome
   for (int c = 0; c < 6; ++c) {
     const Eigen::Isometry3d& anchor =
         placed[std::uniform_int_distribution<size_t>(0, placed.size() - 1)(rng)];
-    const Eigen::Vector2d xy =
-        anchor.translation().head<2>() + Eigen::Vector2d(spread(rng), spread(rng));
+    const double dy = spread(rng);  // one at a time, as in SlideIn
+    const double dx = spread(rng);
+    const Eigen::Vector2d xy = anchor.translation().head<2>() + Eigen::Vector2d(dx, dy);
     const Eigen::Matrix3d flat = RandomOrientation(rng);
     Eigen::Matrix3d R = flat;
     if (Uniform(rng, 0.0, 1.0) < 0.7) {
@@ -205,8 +212,9 @@ Scene MakeIsolatedScene(const BoxDims& dims, int num_boxes, uint32_t seed,
     const CameraIntrinsics& cam = scene.camera;
     for (int tries = 0; tries < 300 && static_cast<int>(scene.boxes.size()) < num_boxes; ++tries) {
       // Aim at a random pixel and put the box centre where that ray meets z = h/2.
-      const Eigen::Vector3d ray_cam((Uniform(rng, 0, cam.width) - cam.cx) / cam.fx,
-                                    (Uniform(rng, 0, cam.height) - cam.cy) / cam.fy, 1.0);
+      const double v = Uniform(rng, 0, cam.height);  // one at a time, as in SlideIn
+      const double u = Uniform(rng, 0, cam.width);
+      const Eigen::Vector3d ray_cam((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.0);
       const Eigen::Vector3d ray = world_T_camera.linear() * ray_cam;
       const Eigen::Vector3d& origin = world_T_camera.translation();
       if (ray.z() > -1e-3) continue;

@@ -65,9 +65,11 @@ SurfaceTexture::SurfaceTexture(const Scene& scene, const RayCaster& caster)
     } else if (Uniform(rng, 0, 1) < 0.08) {
       look.base = Eigen::Vector3d(0.70, 0.68, 0.62) * shade;  // bleached board
     } else {
-      look.base = Eigen::Vector3d(0.47 * Uniform(rng, 0.97, 1.03), 0.28,
-                                  0.125 * Uniform(rng, 0.9, 1.1)) *
-                  shade;  // kraft
+      // One draw at a time (argument order is the compiler's choice); the
+      // last first, as g++ has always drawn them.
+      const double blue = Uniform(rng, 0.9, 1.1);
+      const double red = Uniform(rng, 0.97, 1.03);
+      look.base = Eigen::Vector3d(0.47 * red, 0.28, 0.125 * blue) * shade;  // kraft
     }
     for (double& s : look.face_shade) s = Uniform(rng, 0.95, 1.05);
     if (!look.brick) {

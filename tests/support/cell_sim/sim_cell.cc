@@ -56,8 +56,13 @@ std::vector<testing::SceneBox> PalletLoad(const SimCellOptions& cell, const SimL
                                       (r - 0.5 * (rows - 1)) * (along_y + load.gap_m), z);
         testing::SceneBox box;
         box.dims = d;
-        box.world_T_box = At(nominal + Eigen::Vector3d(jitter(rng), jitter(rng), 0),
-                             (turned ? 0.5 * M_PI : 0.0) + turn(rng));
+        // One draw at a time: argument order is the compiler's choice (g++
+        // goes right to left, and these are the draws it has always made).
+        const double yaw = turn(rng);
+        const double dy = jitter(rng);
+        const double dx = jitter(rng);
+        box.world_T_box =
+            At(nominal + Eigen::Vector3d(dx, dy, 0), (turned ? 0.5 * M_PI : 0.0) + yaw);
         if (!Overlaps(box, boxes)) boxes.push_back(box);  // defensive: never interpenetrate
       }
     }
