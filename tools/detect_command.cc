@@ -64,6 +64,9 @@ constexpr char kHelp[] =
     "  --layer_plane DEG    boxes side by side on one plane (a layer) take the plane\n"
     "                       fitted through all their faces when within DEG of it (12;\n"
     "                       0: every box keeps its own face's plane)\n"
+    "  --seam_colour SHARE  with a colour image, a groove in the depth is a seam only\n"
+    "                       where an image line runs along SHARE of the side (0.3;\n"
+    "                       0: the depth alone)\n"
     "  --tile_uncued BOOL   a face that runs on flat with no seam anywhere is a tile of\n"
     "                       its layer when the layer tiles (false: a laptop lid is not\n"
     "                       boxes; true for cells that see only layers of known boxes)\n"
@@ -102,6 +105,7 @@ absl::Status Run(const CommandArgs& args) {
                          args.SetBool("layer_check", &options.faces.check_layer_tiling),
                          args.SetBool("floor_check", &options.floor_check),
                          args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
+                         args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
                          args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides)}) {
     if (!s.ok()) return s;
   }
@@ -192,6 +196,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "layer_check",
                                                        "floor_check",
                                                        "layer_plane",
+                                                       "seam_colour",
                                                        "tile_uncued",
                                                        "size_tolerance"},
                                                       {"quiet", "kdtree"});

@@ -436,6 +436,52 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
   return m;
 }
 
+// The image line along a side at `position` (face coordinates along the
+// side's outward normal).
+SeamCue ColourLineAt(const DepthImage& depth, const FaceFrame& f, bool along_a, double sign,
+                     double position, const SeamCueOptions& o) {
+  const Eigen::Vector3d across = sign * (along_a ? f.a : f.b);
+  const Eigen::Vector3d along = along_a ? f.b : f.a;
+  const double half_other = along_a ? f.half_b : f.half_a;
+  const Eigen::Vector3d mid = f.c + position * across;
+  return ColourSeamAlong(depth, mid - half_other * along, mid + half_other * along, across, o);
+}
+
+// Whether the colour image shows anything about this face: its brightness
+// varies by at least the seam cue's contrast over the face and a band
+// around it (9 x 9 samples). Only then does a missing line along a depth
+// seam say anything; a blank image is no evidence either way.
+bool ColourVariesAroundFace(const DepthImage& depth, const FaceFrame& f,
+                            const RefinementOptions& o) {
+  float lo = 255.0f, hi = 0.0f;
+  const double reach_a = f.half_a + o.side_band_m, reach_b = f.half_b + o.side_band_m;
+  for (int i = 0; i <= 8; ++i) {
+    for (int j = 0; j <= 8; ++j) {
+      const Eigen::Vector3d p =
+          f.c + (i / 4.0 - 1.0) * reach_a * f.a + (j / 4.0 - 1.0) * reach_b * f.b;
+      if (p.z() <= 0.05) continue;
+      const Eigen::Vector2d px = Project(depth.camera, p);
+      const int u = static_cast<int>(std::lround(px.x())),
+                v = static_cast<int>(std::lround(px.y()));
+      if (!depth.inside(u, v)) continue;
+      lo = std::min(lo, depth.grey_at(u, v));
+      hi = std::max(hi, depth.grey_at(u, v));
+    }
+  }
+  return hi - lo >= o.colour_seams.min_contrast;
+}
+
+// A depth seam without an image line along it (coverage below
+// colour_confirms_seam) is noise in the depth: the face runs on there.
+void ConfirmSeamInColour(const DepthImage& depth, const FaceFrame& f, bool along_a, double sign,
+                         const RefinementOptions& o, SideMeasure* m) {
+  if (m->kind != SideKind::kSeam) return;
+  if (ColourLineAt(depth, f, along_a, sign, m->position, o.colour_seams).coverage <
+      o.colour_confirms_seam) {
+    m->kind = SideKind::kContinues;
+  }
+}
+
 // A continuing side becomes a seam when the colour image shows a straight
 // line along all of it within seam_search_m (plus the colour search) of the
 // hypothesised side.
@@ -566,6 +612,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.max_seam_density", max_seam_density, 0.0, 1.0),
            CheckRange("refinement.weak_seam_density", weak_seam_density, 0.0, 1.0),
            CheckRange("refinement.seam_search_m", seam_search_m, 0.0, 0.2),
+           CheckRange("refinement.colour_confirms_seam", colour_confirms_seam, 0.0, 1.0),
            CheckRange("refinement.seam_halves_min_strength", seam_halves_min_strength, -10.0, 1.0),
            CheckRange("refinement.tile_gap_m", tile_gap_m, 0.0, 0.2),
            CheckRange("refinement.tile_tolerance_m", tile_tolerance_m, 0.0, 0.2),
@@ -612,6 +659,12 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
   // Where the depth shows the face running on with no seam, a straight
   // line in the colour image along the whole side is one.
   if (depth.has_grey()) {
+    if (options.colour_confirms_seam > 0.0 && ColourVariesAroundFace(depth, f, options)) {
+      ConfirmSeamInColour(depth, f, true, 1.0, options, &pa);
+      ConfirmSeamInColour(depth, f, true, -1.0, options, &ma);
+      ConfirmSeamInColour(depth, f, false, 1.0, options, &pb);
+      ConfirmSeamInColour(depth, f, false, -1.0, options, &mb);
+    }
     ColourSeamSide(depth, f, true, 1.0, options, &pa);
     ColourSeamSide(depth, f, true, -1.0, options, &ma);
     ColourSeamSide(depth, f, false, 1.0, options, &pb);

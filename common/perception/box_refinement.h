@@ -59,6 +59,11 @@ struct RefinementOptions {
   // With a registered colour image: a side where the face runs on is a seam
   // when a straight image line runs along all of it (seam_cues.h).
   SeamCueOptions colour_seams;
+  // With a registered colour image: a groove in the depth is a seam only if
+  // at least this share of the side shows an image line along it too (a
+  // stereo camera's noise leaves grooves inside a face; two boxes that
+  // touch leave a line in the image). 0 trusts the depth alone. Unitless.
+  double colour_confirms_seam = 0.3;
   // Iterations of measure-and-update. Count.
   int iterations = 2;
   // Largest correction accepted, beyond which the hypothesis is not this

@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "common/perception/camera_model.h"
@@ -117,6 +119,56 @@ TEST(RefineOnGraspFaceTest, TouchingCartonsMeetAtASeam) {
   const PoseError e = ComparePoses(pose, gt.camera_T_box, kCartonS);
   EXPECT_LT(e.translation_m, 0.004);
   EXPECT_LT(e.rotation_deg, 1.0);
+}
+
+// With a colour image, a groove in the depth is a seam only where an image
+// line runs along it (RefinementOptions::colour_confirms_seam): the same
+// 3 mm gap is a seam when the image shows the gap darker than the cartons,
+// and the face runs on there when the image is one even grey (a stereo
+// camera's noise leaves such grooves inside faces); without the rule, or
+// when the image does not even show the cartons' outline, the depth alone
+// decides.
+TEST(RefineOnGraspFaceTest, ADepthSeamNeedsALineInTheColourImage) {
+  FlatScene s = RenderFlat({Flat(kCartonS, 0.0, 0.0), Flat(kCartonS, kCartonS.l + 0.003, 0.0)});
+  const GroundTruthBox& gt = s.rendered.boxes[0];
+  const int w = s.depth.camera.width, h = s.depth.camera.height;
+  const Eigen::Isometry3d box_T_camera = gt.camera_T_box.inverse();
+  auto sides_with = [&](bool dark_gap, double confirm) {
+    // The cartons' tops a lighter grey than the floor (the image shows their
+    // outline) and, with `dark_gap`, the gap's shadow a dark line 6 mm wide
+    // along it, as a colour camera sees two cartons meet.
+    s.depth.grey.assign(static_cast<size_t>(w) * h, 90.0f);
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        const float z = s.depth.at(u, v);
+        if (std::isnan(z)) continue;
+        const Eigen::Vector3d p = box_T_camera * (z * PixelRay(s.depth.camera, u, v));
+        float& g = s.depth.grey[static_cast<size_t>(v) * w + u];
+        if (p.z() > 0.0) g = 150.0f;
+        if (dark_gap && std::abs(p.x() - (kCartonS.l / 2 + 0.0015)) < 0.003) g = 60.0f;
+      }
+    }
+    RefinementOptions options;
+    options.colour_confirms_seam = confirm;
+    Eigen::Isometry3d pose = Moved(gt.camera_T_box, 0.006, 0.004, 1.0);
+    const RefinementResult r = RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), options, &pose);
+    int seams = 0, runs_on = 0;
+    for (SideKind k : r.sides) {
+      seams += k == SideKind::kSeam;
+      runs_on += k == SideKind::kContinues;
+    }
+    return std::pair{seams, runs_on};
+  };
+  EXPECT_EQ(sides_with(/*dark_gap=*/true, 0.3), std::pair(1, 0));
+  EXPECT_EQ(sides_with(/*dark_gap=*/false, 0.3), std::pair(0, 1));
+  EXPECT_EQ(sides_with(/*dark_gap=*/false, 0.0), std::pair(1, 0));
+  // An image that shows nothing (one grey everywhere, or not registered) is
+  // no evidence against a seam.
+  s.depth.grey.assign(static_cast<size_t>(w) * h, 128.0f);
+  Eigen::Isometry3d pose = Moved(gt.camera_T_box, 0.006, 0.004, 1.0);
+  const RefinementResult blank =
+      RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), RefinementOptions{}, &pose);
+  EXPECT_EQ(std::count(blank.sides.begin(), blank.sides.end(), SideKind::kSeam), 1);
 }
 
 // A carton-sized reading on one end of a face twice as long: the side
