@@ -65,7 +65,7 @@ constexpr char kHelp[] =
     "                       fitted through all their faces when within DEG of it (12;\n"
     "                       0: every box keeps its own face's plane)\n"
     "  --seam_colour SHARE  with a colour image, a groove in the depth is a seam only\n"
-    "                       where an image line runs along SHARE of the side (0.3;\n"
+    "                       where an image line runs along SHARE of the side (0.5;\n"
     "                       0: the depth alone)\n"
     "  --tile_uncued BOOL   a face that runs on flat with no seam anywhere is a tile of\n"
     "                       its layer when the layer tiles (false: a laptop lid is not\n"

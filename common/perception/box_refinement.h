@@ -63,7 +63,7 @@ struct RefinementOptions {
   // at least this share of the side shows an image line along it too (a
   // stereo camera's noise leaves grooves inside a face; two boxes that
   // touch leave a line in the image). 0 trusts the depth alone. Unitless.
-  double colour_confirms_seam = 0.3;
+  double colour_confirms_seam = 0.5;
   // Iterations of measure-and-update. Count.
   int iterations = 2;
   // Largest correction accepted, beyond which the hypothesis is not this
