@@ -48,7 +48,8 @@ class CellWorldTest : public ::testing::Test {
 
   // The top face centre of box i, world.
   Eigen::Vector3d TopOf(int i) const {
-    const SimBox& box = world_->Boxes()[static_cast<size_t>(i)];
+    // Boxes() returns a copy: keep the box, not a reference into it.
+    const SimBox box = world_->Boxes()[static_cast<size_t>(i)];
     return box.world_T_box * Eigen::Vector3d(0, 0, 0.5 * box.dims.h);
   }
 
