@@ -74,8 +74,8 @@ class CellWorldTest : public ::testing::Test {
         "  set_tool_digital_out(0, True)\n  movel(%s, a=1, v=0.25)\n"
         "  movej(%s, a=1.4, v=1.05)\n  movel(%s, a=1, v=0.25)\n"
         "  set_tool_digital_out(0, False)\n  movel(%s, a=1, v=0.25)\n",
-        DownAt(grasp, 0.1), DownAt(grasp), DownAt(grasp, 0.25), DownAt(place, 0.25),
-        DownAt(place), DownAt(place, 0.25));
+        DownAt(grasp, 0.1), DownAt(grasp), DownAt(grasp, 0.25), DownAt(place, 0.25), DownAt(place),
+        DownAt(place, 0.25));
   }
 
   Eigen::Vector3d PlaceSpot() const {

@@ -42,7 +42,8 @@ struct CameraRange {
 };
 CameraRange Range(const CameraPlacement& p, double lo, double hi, double tilt) {
   return {p.min_distance_m >= 0 ? p.min_distance_m : lo,
-          p.max_distance_m >= 0 ? p.max_distance_m : hi, p.max_tilt_deg >= 0 ? p.max_tilt_deg : tilt};
+          p.max_distance_m >= 0 ? p.max_distance_m : hi,
+          p.max_tilt_deg >= 0 ? p.max_tilt_deg : tilt};
 }
 
 void SetRandomCamera(const Eigen::Vector3d& look_at, double dist_lo, double dist_hi,

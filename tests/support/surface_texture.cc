@@ -114,8 +114,10 @@ SurfaceTexture::SurfaceTexture(const Scene& scene, const RayCaster& caster)
         p.v0 = Uniform(rng, lo2, hi2 - h);
         p.v1 = p.v0 + h;
         p.round = !p.label && Uniform(rng, 0, 1) < 0.5;
-        static const Eigen::Vector3d kInks[] = {{0.02, 0.03, 0.12}, {0.35, 0.02, 0.02},
-                                                {0.02, 0.15, 0.04}, {0.02, 0.02, 0.02},
+        static const Eigen::Vector3d kInks[] = {{0.02, 0.03, 0.12},
+                                                {0.35, 0.02, 0.02},
+                                                {0.02, 0.15, 0.04},
+                                                {0.02, 0.02, 0.02},
                                                 {0.6, 0.35, 0.01}};
         p.ink = kInks[std::uniform_int_distribution<int>(0, 4)(rng)];
         look.prints.push_back(p);
@@ -198,7 +200,8 @@ Eigen::Vector3d SurfaceTexture::BoxAlbedo(int i, int face, const Eigen::Vector3d
       const double along = wide ? ls : lt, across = wide ? lt : ls;
       if (across > 0.55 && across < 0.88 && along > 0.08 && along < 0.92) {
         const int module = static_cast<int>((along - 0.08) / 0.84 * 95);
-        if (Hash(p.seed, static_cast<uint32_t>(module), 5u) & 1u) col = Eigen::Vector3d::Constant(0.03);
+        if (Hash(p.seed, static_cast<uint32_t>(module), 5u) & 1u)
+          col = Eigen::Vector3d::Constant(0.03);
       } else if (across > 0.1 && across < 0.47 && along > 0.08) {
         const int row = static_cast<int>((across - 0.1) / 0.093);
         const double in_row = (across - 0.1) / 0.093 - row;
