@@ -488,13 +488,8 @@ void ConfirmSeamInColour(const DepthImage& depth, const FaceFrame& f, bool along
 void ColourSeamSide(const DepthImage& depth, const FaceFrame& f, bool along_a, double sign,
                     const RefinementOptions& o, SideMeasure* m) {
   if (m->kind != SideKind::kContinues) return;
-  const Eigen::Vector3d across = sign * (along_a ? f.a : f.b);
-  const Eigen::Vector3d along = along_a ? f.b : f.a;
   const double half = along_a ? f.half_a : f.half_b;
-  const double half_other = along_a ? f.half_b : f.half_a;
-  const Eigen::Vector3d mid = f.c + half * across;
-  const SeamCue cue = ColourSeamAlong(depth, mid - half_other * along, mid + half_other * along,
-                                      across, o.colour_seams);
+  const SeamCue cue = ColourLineAt(depth, f, along_a, sign, half, o.colour_seams);
   if (!cue.seam || std::abs(cue.offset_m) > o.seam_search_m + 0.004) return;
   m->kind = SideKind::kSeam;
   m->position = half + cue.offset_m;
@@ -659,7 +654,11 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
   // Where the depth shows the face running on with no seam, a straight
   // line in the colour image along the whole side is one.
   if (depth.has_grey()) {
-    if (options.colour_confirms_seam > 0.0 && ColourVariesAroundFace(depth, f, options)) {
+    // Only a face with a depth seam is asked about (most have none).
+    const bool depth_seam = pa.kind == SideKind::kSeam || ma.kind == SideKind::kSeam ||
+                            pb.kind == SideKind::kSeam || mb.kind == SideKind::kSeam;
+    if (depth_seam && options.colour_confirms_seam > 0.0 &&
+        ColourVariesAroundFace(depth, f, options)) {
       ConfirmSeamInColour(depth, f, true, 1.0, options, &pa);
       ConfirmSeamInColour(depth, f, true, -1.0, options, &ma);
       ConfirmSeamInColour(depth, f, false, 1.0, options, &pb);
