@@ -67,6 +67,8 @@ constexpr char kHelp[] =
     "  --seam_colour SHARE  with a colour image, a groove in the depth is a seam only\n"
     "                       where an image line runs along SHARE of the side (0.5;\n"
     "                       0: the depth alone)\n"
+    "  --sparse_seam SHARE  a line where SHARE more of the returns are missing than\n"
+    "                       beside it is a seam (a gap finer than a pixel; 0.05; 0: off)\n"
     "  --tile_uncued BOOL   a face that runs on flat with no seam anywhere is a tile of\n"
     "                       its layer when the layer tiles (false: a laptop lid is not\n"
     "                       boxes; true for cells that see only layers of known boxes)\n"
@@ -106,6 +108,7 @@ absl::Status Run(const CommandArgs& args) {
                          args.SetBool("floor_check", &options.floor_check),
                          args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
                          args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
+                         args.SetDouble("sparse_seam", &options.refinement.sparse_seam_missing),
                          args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides)}) {
     if (!s.ok()) return s;
   }
@@ -197,6 +200,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "floor_check",
                                                        "layer_plane",
                                                        "seam_colour",
+                                                       "sparse_seam",
                                                        "tile_uncued",
                                                        "size_tolerance"},
                                                       {"quiet", "kdtree"});

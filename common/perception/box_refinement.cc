@@ -56,7 +56,8 @@ FaceFrame MakeFaceFrame(const Eigen::Isometry3d& camera_T_box, const BoxDims& di
 // corner's points are in two bands). Per side: the points on the plane,
 // the points in front of it (an occluder) and where every pixel's ray meets
 // the plane (what a fully seen face would give: the reference for point
-// densities).
+// densities; its n is 1 where that pixel returned a point on the plane, 0
+// where it returned none or one off the plane).
 struct FacePoints {
   // The points on the plane >= 1 cm inside every side, as their count and
   // the sums of their coordinates and products (all the plane fit needs).
@@ -138,13 +139,16 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
     double sa = 0, sb = 0, sn = 0, saa = 0, sab = 0, san = 0, sbb = 0, sbn = 0, snn = 0;
     for (int u = ua; u <= ub; ++u) {
       const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row, n_r = n_x[u - ua] + n_row;
+      const float z = zrow[u];
       if ((u <= skip0 || u >= skip1) && std::abs(n_r) > 1e-6) {
         const double t = n_c / n_r;
-        const FacePoint q{t * a_r - a_c, t * b_r - b_c, 0.0};
-        const double qa = std::abs(q.a), qb = std::abs(q.b);
-        if (qa <= lim_a && qb <= lim_b && (qa > in_a || qb > in_b)) to_sides(q, out.grid);
+        const double qa = t * a_r - a_c, qb = t * b_r - b_c;
+        if (std::abs(qa) <= lim_a && std::abs(qb) <= lim_b &&
+            (std::abs(qa) > in_a || std::abs(qb) > in_b)) {
+          const bool hit = !std::isnan(z) && std::abs(z * n_r - n_c) <= plane_tol;
+          to_sides(FacePoint{qa, qb, hit ? 1.0 : 0.0}, out.grid);
+        }
       }
-      const float z = zrow[u];
       if (std::isnan(z)) continue;
       const FacePoint q{z * a_r - a_c, z * b_r - b_c, z * n_r - n_c};
       if (std::abs(q.a) > lim_a || std::abs(q.b) > lim_b) continue;
@@ -230,15 +234,16 @@ class SeamScan {
     }
     for (const FacePoint& p : grid) {  // where pixels meet the plane, same band
       double across, along;
-      if (band(p, &across, &along)) expected_.push_back({across, along});
+      if (band(p, &across, &along)) expected_.push_back({across, along, p.n});
     }
-    BucketSort(&expected_, -reach, reach, [](const auto& e) { return e.first; });
+    BucketSort(&expected_, -reach, reach, [](const Pixel& e) { return e.across; });
     BucketSort(&rows, -reach, reach, [](const Row& r) { return r.across; });
     rows_ = std::move(rows);
     Index();
     w_ = std::max(0.003, 2.5 * pixel_m);  // centre window width
     f0_ = w_ / 2 + pixel_m;               // flanks
     f1_ = w_ / 2 + 6 * pixel_m;
+    spread_ = pixel_m / 2;
   }
 
   // The points of this side with along in [lo, hi).
@@ -248,17 +253,18 @@ class SeamScan {
       if (r.along >= lo && r.along < hi) part.rows_.push_back(r);
     }
     for (const auto& e : expected_) {
-      if (e.second >= lo && e.second < hi) part.expected_.push_back(e);
+      if (e.along >= lo && e.along < hi) part.expected_.push_back(e);
     }
     part.Index();
     part.w_ = w_;
     part.f0_ = f0_;
     part.f1_ = f1_;
+    part.spread_ = spread_;
     return part;
   }
 
-  size_t points() const { return xs_.size(); }
-  size_t expected() const { return expected_x_.size(); }
+  size_t points() const { return points_.size(); }
+  size_t expected() const { return grid_.size(); }
 
   // How far past its threshold the strongest test is at offset c (<= 0: no
   // seam there); nullopt when too few points to say.
@@ -281,7 +287,26 @@ class SeamScan {
     const double joint_strength =
         std::min((o_.weak_seam_density - density_ratio) / o_.weak_seam_density,
                  (groove - 0.5 * o_.min_seam_depth_m) / o_.min_seam_depth_m);
-    return std::max({density_strength, groove_strength, joint_strength});
+    // A sparse line of missing returns (a gap finer than a pixel): the
+    // missing share above the flanks', and how unlikely that excess is at
+    // the flanks' rate (a floor of one in 200 keeps a spotless face from
+    // making every stray miss significant).
+    double sparse_strength = -std::numeric_limits<double>::infinity();
+    if (o_.sparse_seam_missing > 0.0 && o_.sparse_seam_sigma > 0.0) {
+      // Counted on the pixels, not the points: a groove displaces points
+      // sideways (a deeper point on a slanted ray lands further out) and
+      // thins them on one flank without any return missing.
+      const auto [pc, hc] = PixelsIn(c - w_ / 2, c + w_ / 2);
+      const auto [pl, hl] = PixelsIn(c - f1_, c - f0_);
+      const auto [pr, hr] = PixelsIn(c + f0_, c + f1_);
+      const double missing_c = 1.0 - hc / pc, missing_f = 1.0 - (hl + hr) / (pl + pr);
+      const double excess = (pc - hc) - pc * missing_f;
+      const double sigma = std::sqrt(pc * std::max(missing_f, 0.005) + 1.0);
+      sparse_strength =
+          std::min((missing_c - missing_f - o_.sparse_seam_missing) / o_.sparse_seam_missing,
+                   (excess / sigma - o_.sparse_seam_sigma) / o_.sparse_seam_sigma);
+    }
+    return std::max({density_strength, groove_strength, joint_strength, sparse_strength});
   }
 
  private:
@@ -293,32 +318,92 @@ class SeamScan {
   };
   explicit SeamScan(const RefinementOptions& o) : o_(o) {}
 
-  void Index() {
-    xs_.resize(rows_.size());
-    prefix_.assign(rows_.size() + 1, 0.0);
-    for (size_t i = 0; i < rows_.size(); ++i) {
-      xs_[i] = rows_[i].across;
-      prefix_[i + 1] = prefix_[i] + rows_[i].height;
+  // Sorted positions x with prefix sums of 1, x, y and x y: the count and
+  // y-sum of the points in a window [lo, hi) when each point is spread
+  // evenly over [x - spread, x + spread] (a pixel's footprint). A side that
+  // runs along a pixel row or column meets the pixel grid in rows a pixel
+  // apart; counted as points, a window's share of them jumps by a third as
+  // its ends cross a row, and where the measured points lie jittered off
+  // the rows (lateral noise) but the ray-plane grid does not, that jump
+  // reads as a dip in density. Spread alike, both count smoothly.
+  class SpreadSums {
+   public:
+    void Build(const std::vector<double>& x, const std::vector<double>& y) {
+      x_ = x;
+      sum_.assign(x.size() + 1, Sums{});
+      for (size_t i = 0; i < x.size(); ++i) {
+        sum_[i + 1] = {sum_[i].x + x[i], sum_[i].y + y[i], sum_[i].xy + x[i] * y[i]};
+      }
     }
-    expected_x_.resize(expected_.size());
-    for (size_t i = 0; i < expected_.size(); ++i) expected_x_[i] = expected_[i].first;
+    size_t size() const { return x_.size(); }
+    // (weighted count, weighted y-sum) over [lo, hi).
+    std::pair<double, double> Window(double lo, double hi, double spread) const {
+      const double h = std::min(spread, 0.5 * (hi - lo));
+      if (h <= 0.0) {
+        const size_t a = Index(lo), b = Index(hi);
+        return {static_cast<double>(b - a), sum_[b].y - sum_[a].y};
+      }
+      const size_t i0 = Index(lo - h), i1 = Index(lo + h), i2 = Index(hi - h), i3 = Index(hi + h);
+      const double n01 = static_cast<double>(i1 - i0), n23 = static_cast<double>(i3 - i2);
+      const Sums s01 = Diff(i0, i1), s12 = Diff(i1, i2), s23 = Diff(i2, i3);
+      // Points near lo weigh (x - lo + h) / 2h, near hi (hi + h - x) / 2h.
+      const double count = static_cast<double>(i2 - i1) + (s01.x - n01 * (lo - h)) / (2 * h) +
+                           (n23 * (hi + h) - s23.x) / (2 * h);
+      const double ysum =
+          s12.y + (s01.xy - (lo - h) * s01.y) / (2 * h) + ((hi + h) * s23.y - s23.xy) / (2 * h);
+      return {count, ysum};
+    }
+
+   private:
+    struct Sums {
+      double x = 0.0, y = 0.0, xy = 0.0;
+    };
+    size_t Index(double v) const { return std::lower_bound(x_.begin(), x_.end(), v) - x_.begin(); }
+    Sums Diff(size_t a, size_t b) const {
+      return {sum_[b].x - sum_[a].x, sum_[b].y - sum_[a].y, sum_[b].xy - sum_[a].xy};
+    }
+    std::vector<double> x_;
+    std::vector<Sums> sum_;
+  };
+
+  void Index() {
+    std::vector<double> x(rows_.size()), y(rows_.size());
+    for (size_t i = 0; i < rows_.size(); ++i) {
+      x[i] = rows_[i].across;
+      y[i] = rows_[i].height;
+    }
+    points_.Build(x, y);
+    x.resize(expected_.size());
+    y.resize(expected_.size());
+    for (size_t i = 0; i < expected_.size(); ++i) {
+      x[i] = expected_[i].across;
+      y[i] = expected_[i].hit;
+    }
+    grid_.Build(x, y);
   }
   // Count and height sum of points with across in [lo, hi).
   std::pair<double, double> Window(double lo, double hi) const {
-    const size_t a = std::lower_bound(xs_.begin(), xs_.end(), lo) - xs_.begin();
-    const size_t b = std::lower_bound(xs_.begin(), xs_.end(), hi) - xs_.begin();
-    return {static_cast<double>(b - a), prefix_[b] - prefix_[a]};
+    return points_.Window(lo, hi, spread_);
   }
-  double ExpectedIn(double lo, double hi) const {
-    return static_cast<double>(std::lower_bound(expected_x_.begin(), expected_x_.end(), hi) -
-                               std::lower_bound(expected_x_.begin(), expected_x_.end(), lo));
+  // Pixels whose ray meets the plane in [lo, hi), and how many of them
+  // returned a point on it.
+  std::pair<double, double> PixelsIn(double lo, double hi) const {
+    return grid_.Window(lo, hi, spread_);
   }
+  double ExpectedIn(double lo, double hi) const { return PixelsIn(lo, hi).first; }
 
   const RefinementOptions& o_;
   std::vector<Row> rows_;
-  std::vector<std::pair<double, double>> expected_;  // (across, along)
-  std::vector<double> xs_, prefix_, expected_x_;
+  struct Pixel {
+    double across, along, hit;  // hit: 1 with a return on the plane, else 0
+    bool operator<(const Pixel& p) const {
+      return across != p.across ? across < p.across : along < p.along;
+    }
+  };
+  std::vector<Pixel> expected_;
+  SpreadSums points_, grid_;
   double w_ = 0.0, f0_ = 0.0, f1_ = 0.0;
+  double spread_ = 0.0;  // half a pixel's footprint on the face
 };
 
 // Looks for the seam two touching boxes leave between coplanar faces. A
@@ -391,7 +476,7 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
   if (inner < 10) return m;  // hidden or cut: no say
   // Something in front of the plane just past the side: the face may go on
   // underneath it, so the side is not where the face ends.
-  int in_front = 0;
+  int in_front = 0;  // lines on which anything stands in front of the plane there
   for (const FacePoint& p : front) {
     const double across = sign * (along_a ? p.a : p.b);
     const double along = along_a ? p.b : p.a;
@@ -497,25 +582,18 @@ void ColourSeamSide(const DepthImage& depth, const FaceFrame& f, bool along_a, d
 
 // True when, past a side, the first surface after a run of missing returns
 // lies in front of the face's plane (the gap is the shadow of something
-// standing over the face), or the first surface right at the side lies a
-// whole box dimension above it on all three lines (a box standing on the
-// face): the face may go on underneath, so the side is not where the face
-// ends. Looks up to 8 cm out along three lines.
+// standing over the face), or the first surface right at the side (past the
+// face's own blur) lies in front of it on two of three lines (a box of an
+// upper layer, its wall or its top, standing over this one): the face may
+// go on underneath, so the side is not where the face ends. Looks up to
+// 8 cm out along three lines across the side.
 bool ShadowedByOccluder(const DepthImage& depth, const Eigen::Vector3d& side_centre,
                         const Eigen::Vector3d& across, const Eigen::Vector3d& along,
-                        double half_along, const Eigen::Vector3d& normal, const BoxDims& dims,
-                        const RefinementOptions& o) {
-  // Right past the side (no shadow between), a surface a whole box
-  // dimension above the face along the whole side (all three lines) is the
-  // top of a box standing on it; on one line only it is more often a
-  // neighbour in a heap whose top happens to lie that high.
-  auto rests_on_face = [&](double height) {
-    for (int k = 0; k < 3; ++k) {
-      if (std::abs(height - dims[k]) < 0.025) return true;
-    }
-    return false;
-  };
-  int resting = 0;  // lines on which a box stands on the face right at the side
+                        double half_along, const RefinementOptions& o,
+                        const Eigen::Vector3d& normal) {
+  // One line only is more often a neighbour in a heap standing higher at
+  // one corner than a face that goes on.
+  int in_front = 0;  // lines on which something stands in front of the plane at the side
   for (double t : {-0.6, 0.0, 0.6}) {
     const Eigen::Vector3d start = side_centre + t * half_along * along;
     for (double d = 0.004; d < 0.08; d += 0.003) {
@@ -528,12 +606,15 @@ bool ShadowedByOccluder(const DepthImage& depth, const Eigen::Vector3d& side_cen
       const float z = depth.at(u, v);
       if (std::isnan(z)) continue;
       const double height = (z * PixelRay(depth.camera, u, v) - q).dot(normal);
+      // Within the side's blur (mixed pixels, a side measured a few
+      // millimetres short) the face itself may still show: look past it.
+      if (std::abs(height) <= o.plane_tolerance_m && d <= 0.012) continue;
       if (height > o.plane_tolerance_m && d > 0.012) return true;
-      resting += height > o.plane_tolerance_m && rests_on_face(height);
+      in_front += height > o.plane_tolerance_m;
       break;  // a surface at or behind the plane: a real end
     }
   }
-  return resting == 3;
+  return in_front >= 2;
 }
 
 // Where the face's plane ends beyond one side: marches outward from the
@@ -606,6 +687,8 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.min_seam_depth_m", min_seam_depth_m, 0.0, 0.1),
            CheckRange("refinement.max_seam_density", max_seam_density, 0.0, 1.0),
            CheckRange("refinement.weak_seam_density", weak_seam_density, 0.0, 1.0),
+           CheckRange("refinement.sparse_seam_missing", sparse_seam_missing, 0.0, 1.0),
+           CheckRange("refinement.sparse_seam_sigma", sparse_seam_sigma, 0.0, 100.0),
            CheckRange("refinement.seam_search_m", seam_search_m, 0.0, 0.2),
            CheckRange("refinement.colour_confirms_seam", colour_confirms_seam, 0.0, 1.0),
            CheckRange("refinement.seam_halves_min_strength", seam_halves_min_strength, -10.0, 1.0),
@@ -724,7 +807,7 @@ void MarkShadowedSides(const DepthImage& depth, const BoxDims& dims, BoxFace gra
   for (int i = 0; i < 4; ++i) {
     if (result.sides[i] == SideKind::kFree &&
         ShadowedByOccluder(depth, f.c + half_across[i] * across[i], across[i], along[i],
-                           half_along[i], f.n, dims, options)) {
+                           half_along[i], options, f.n)) {
       result.sides[i] = SideKind::kOccluded;
       --result.free_sides;
     }
@@ -763,6 +846,11 @@ void TileContinuingSides(const DepthImage& depth, const BoxDims& dims, BoxFace g
     std::array<std::array<double, 3>, 2> extent = {
         {{size[0], size[0], size[0]}, {size[1], size[1], size[1]}}};
     bool measured = true;
+    // Past each continuing side the layer must run on for a whole number
+    // of tiles too (none: it ends within tile_tolerance_m): the extent
+    // alone does not change as a box slides along a row between two
+    // continuing sides, so it does not place the box.
+    bool on_tile_bounds = true;
     for (int ax = 0; ax < 2 && measured; ++ax) {
       for (int sgn = 0; sgn < 2 && measured; ++sgn) {
         const SideKind kind = result.sides[2 * ax + sgn];
@@ -776,7 +864,13 @@ void TileContinuingSides(const DepthImage& depth, const BoxDims& dims, BoxFace g
           measured = false;
           break;
         }
-        for (int l = 0; l < 3; ++l) extent[ax][l] += (*runs)[l] + options.tile_gap_m;
+        for (int l = 0; l < 3; ++l) {
+          extent[ax][l] += (*runs)[l] + options.tile_gap_m;
+          if (kind == SideKind::kContinues && (*runs)[l] > options.tile_tolerance_m &&
+              TileCount((*runs)[l], size[ax], options.tile_tolerance_m, options) == 0) {
+            on_tile_bounds = false;
+          }
+        }
       }
     }
     // Tiles of (tile_a, tile_b) covering the longest runs, or 0 when some
@@ -795,7 +889,8 @@ void TileContinuingSides(const DepthImage& depth, const BoxDims& dims, BoxFace g
       }
       return count[0] * count[1];
     };
-    const int tiles = measured ? tiling(size[0], size[1], options.tile_tolerance_m) : 0;
+    const int tiles =
+        measured && on_tile_bounds ? tiling(size[0], size[1], options.tile_tolerance_m) : 0;
     bool fewest = tiles > 0;
     for (int i = 0; i < 3 && fewest; ++i) {
       for (int j = 0; j < 3 && fewest; ++j) {

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -169,6 +170,78 @@ TEST(RefineOnGraspFaceTest, ADepthSeamNeedsALineInTheColourImage) {
   const RefinementResult blank =
       RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), RefinementOptions{}, &pose);
   EXPECT_EQ(std::count(blank.sides.begin(), blank.sides.end(), SideKind::kSeam), 1);
+}
+
+// Two cartons end to end with no gap at all leave nothing in exact depth:
+// the face runs on. A gap finer than a pixel shows as a sparse line of
+// missing returns along the seam (here every third pixel within 0.75 mm of
+// it returns nothing): a seam (RefinementOptions::sparse_seam_missing),
+// unless the test is off. The same number of missing returns scattered over
+// the face is no seam.
+TEST(RefineOnGraspFaceTest, AGapFinerThanAPixelShowsAsASparseLineOfMissingReturns) {
+  const FlatScene clean = RenderFlat({Flat(kCartonS, 0.0, 0.0), Flat(kCartonS, kCartonS.l, 0.0)});
+  const GroundTruthBox& gt = clean.rendered.boxes[0];
+  const Eigen::Isometry3d box_T_camera = gt.camera_T_box.inverse();
+  const int w = clean.depth.camera.width, h = clean.depth.camera.height;
+  // Pixels on the two tops near the seam line (box x = l / 2), in order.
+  std::vector<size_t> on_line, on_tops;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const float z = clean.depth.at(u, v);
+      if (std::isnan(z)) continue;
+      const Eigen::Vector3d p = box_T_camera * (z * PixelRay(clean.depth.camera, u, v));
+      if (p.z() < kCartonS.h / 2 - 0.002 || std::abs(p.y()) > kCartonS.b / 2 - 0.01) continue;
+      const size_t i = static_cast<size_t>(v) * w + u;
+      if (std::abs(p.x() - kCartonS.l / 2) < 0.00075) on_line.push_back(i);
+      if (std::abs(p.x()) < kCartonS.l / 2 - 0.03) on_tops.push_back(i);
+    }
+  }
+  ASSERT_GT(on_line.size(), 60u);
+  auto seams = [&](const std::vector<size_t>& drop, double sparse) {
+    DepthImage depth = clean.depth;
+    for (size_t i : drop) depth.z[i] = std::numeric_limits<float>::quiet_NaN();
+    RefinementOptions options;
+    options.sparse_seam_missing = sparse;
+    Eigen::Isometry3d pose = Moved(gt.camera_T_box, 0.003, 0.002, 0.5);
+    const RefinementResult r = RefineOnGraspFace(depth, kCartonS, TopFace(gt), options, &pose);
+    EXPECT_TRUE(r.ok);
+    return std::count(r.sides.begin(), r.sides.end(), SideKind::kSeam);
+  };
+  std::vector<size_t> line_drop, scattered;
+  for (size_t k = 0; k < on_line.size(); k += 3) line_drop.push_back(on_line[k]);
+  const size_t every = on_tops.size() / line_drop.size();
+  for (size_t k = 0; k < on_tops.size() && scattered.size() < line_drop.size(); k += every) {
+    scattered.push_back(on_tops[k]);
+  }
+  EXPECT_EQ(seams({}, 0.05), 0) << "no gap, no seam";
+  EXPECT_EQ(seams(line_drop, 0.05), 1) << "a sparse line of missing returns";
+  EXPECT_EQ(seams(line_drop, 0.0), 0) << "the test off";
+  EXPECT_EQ(seams(scattered, 0.05), 0) << "as many misses, scattered";
+}
+
+// A layer of touching cartons tiles whole, but a reading slid along a row
+// between two sides where the face runs on (no gap to see) is not one of
+// its tiles: past each such side the layer must run on a whole number of
+// cartons. Two rows of three, end to end with no gap, the rows 3 mm apart
+// (a seam on the reading's +b side).
+TEST(RefineOnGraspFaceTest, AReadingSlidAlongARowIsNotATile) {
+  std::vector<SceneBox> boxes;
+  for (int row = 0; row < 2; ++row) {
+    for (int col = -1; col <= 1; ++col) {
+      boxes.push_back(Flat(kCartonS, col * kCartonS.l, row * (kCartonS.b + 0.003)));
+    }
+  }
+  const FlatScene s = RenderFlat(boxes, 1.3);
+  const GroundTruthBox& gt = s.rendered.boxes[1];  // row 0, the middle one
+  auto sides = [&](double slide) {
+    Eigen::Isometry3d pose = Moved(gt.camera_T_box, slide, 0.0, 0.0);
+    const RefinementResult r =
+        RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), RefinementOptions{}, &pose);
+    EXPECT_TRUE(r.ok) << slide;
+    return std::pair{r.sides[0], r.sides[1]};
+  };
+  EXPECT_EQ(sides(0.0), std::pair(SideKind::kTiled, SideKind::kTiled));
+  EXPECT_EQ(sides(0.04), std::pair(SideKind::kContinues, SideKind::kContinues));
 }
 
 // A carton-sized reading on one end of a face twice as long: the side
