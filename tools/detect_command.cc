@@ -69,6 +69,8 @@ constexpr char kHelp[] =
     "                       0: the depth alone)\n"
     "  --sparse_seam SHARE  a line where SHARE more of the returns are missing than\n"
     "                       beside it is a seam (a gap finer than a pixel; 0.05; 0: off)\n"
+    "  --eroded_faces SHARE a planar patch smaller than a face but SHARE of it along\n"
+    "                       both sides proposes the face centred on it (0.65; 0: off)\n"
     "  --tile_uncued BOOL   a face that runs on flat with no seam anywhere is a tile of\n"
     "                       its layer when the layer tiles (false: a laptop lid is not\n"
     "                       boxes; true for cells that see only layers of known boxes)\n"
@@ -109,6 +111,7 @@ absl::Status Run(const CommandArgs& args) {
                          args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
                          args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
                          args.SetDouble("sparse_seam", &options.refinement.sparse_seam_missing),
+                         args.SetDouble("eroded_faces", &options.faces.min_eroded_share),
                          args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides)}) {
     if (!s.ok()) return s;
   }
@@ -201,6 +204,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "layer_plane",
                                                        "seam_colour",
                                                        "sparse_seam",
+                                                       "eroded_faces",
                                                        "tile_uncued",
                                                        "size_tolerance"},
                                                       {"quiet", "kdtree"});

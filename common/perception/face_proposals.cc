@@ -82,6 +82,10 @@ absl::Status FaceProposalOptions::Validate() const {
         " (0, 1], layer_match_m=", layer_match_m, " (0, 0.2], layer_match_deg=", layer_match_deg,
         " (0, 45], layer_min_fill=", layer_min_fill, " (0, 1]"));
   }
+  if (!(min_eroded_share >= 0.0 && min_eroded_share <= 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("faces.min_eroded_share=", min_eroded_share, " is outside [0, 1]"));
+  }
   return absl::OkStatus();
 }
 
@@ -275,11 +279,19 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
       for (int n = 0; n < 3; ++n) {
         const int a = (n + 1) % 3, b = (n + 2) % 3;
         for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {
+          const FaceTiling t{n, su, sv, 1, 1};
           if (dims[su] > rect.width + o.size_tolerance_m ||
               dims[sv] > rect.height + o.size_tolerance_m) {
+            // Smaller than the face but most of it: a face whose rim the
+            // segmentation took in (a stereo camera's noise, rounded edges)
+            // is centred on its outline.
+            if (o.min_eroded_share > 0.0 && rect.width >= o.min_eroded_share * dims[su] &&
+                rect.height >= o.min_eroded_share * dims[sv]) {
+              const Eigen::Isometry3d pose = TilePose(rect, t, dims, 0.0, 0.0);
+              if (on_patch(pose, t)) out.poses.push_back(pose);
+            }
             continue;
           }
-          const FaceTiling t{n, su, sv, 1, 1};
           for (double cu : {-1.0, 1.0}) {
             for (double cv : {-1.0, 1.0}) {
               const Eigen::Isometry3d pose =

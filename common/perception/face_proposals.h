@@ -30,6 +30,10 @@ struct FaceProposalOptions {
   // (n - 1) max_gap_m long, within size_tolerance_m. Metres.
   double size_tolerance_m = 0.02;
   double max_gap_m = 0.005;
+  // An outline smaller than a face but at least this share of it along
+  // both sides proposes the face centred on it (its rim taken in by the
+  // segmentation); 0 proposes nothing from such outlines. Unitless.
+  double min_eroded_share = 0.65;
   // Patches seen more obliquely than this are not proposed from. Degrees.
   double max_view_angle_deg = 65.0;
   // A patch with more tiles than this is not tiled. Count.
