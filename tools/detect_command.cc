@@ -71,6 +71,8 @@ constexpr char kHelp[] =
     "                       beside it is a seam (a gap finer than a pixel; 0.05; 0: off)\n"
     "  --eroded_faces SHARE a planar patch smaller than a face but SHARE of it along\n"
     "                       both sides proposes the face centred on it (0.65; 0: off)\n"
+    "  --merge_patches N    planar patches within N cells of each other on one plane\n"
+    "                       are one (a face noise broke up; 2; 0: no merging)\n"
     "  --tile_uncued BOOL   a face that runs on flat with no seam anywhere is a tile of\n"
     "                       its layer when the layer tiles (false: a laptop lid is not\n"
     "                       boxes; true for cells that see only layers of known boxes)\n"
@@ -112,6 +114,7 @@ absl::Status Run(const CommandArgs& args) {
                          args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
                          args.SetDouble("sparse_seam", &options.refinement.sparse_seam_missing),
                          args.SetDouble("eroded_faces", &options.faces.min_eroded_share),
+                         args.SetInt("merge_patches", &options.faces.patches.merge_gap_cells),
                          args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides)}) {
     if (!s.ok()) return s;
   }
@@ -205,6 +208,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "seam_colour",
                                                        "sparse_seam",
                                                        "eroded_faces",
+                                                       "merge_patches",
                                                        "tile_uncued",
                                                        "size_tolerance"},
                                                       {"quiet", "kdtree"});

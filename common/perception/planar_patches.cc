@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <deque>
 #include <numeric>
 
@@ -34,6 +35,116 @@ struct Moments {
   }
 };
 
+// Union-find over patch ids.
+int Root(std::vector<int>& parent, int i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
+// Joins patches that lie within merge_gap_cells of each other on one plane:
+// a face that noise broke into pieces (an active-stereo camera's smoothing
+// leaves low bumps whose cell normals stray past max_normal_angle_deg, and
+// the cells between pieces fail the flatness test). Each pair is judged on
+// the pieces' fitted planes, which average out what split them: normals
+// within merge_angle_deg, and each centroid on the other's plane within
+// the growth tolerance. Largest shared boundary first; a joined patch is
+// refitted before it is compared again.
+template <typename Tolerance>
+void MergeCoplanarPatches(const PlanarPatchOptions& o, const Tolerance& tolerance,
+                          PlanarPatches* out) {
+  const int n = static_cast<int>(out->patches.size());
+  if (n < 2) return;
+  const int W = out->cells_wide, H = out->cells_high, g = o.merge_gap_cells;
+  // Pairs of patches with cells within g of each other, with how many.
+  std::vector<std::pair<uint64_t, int>> pairs;
+  {
+    std::vector<uint64_t> keys;
+    for (int cv = 0; cv < H; ++cv) {
+      for (int cu = 0; cu < W; ++cu) {
+        const int a = out->label[static_cast<size_t>(cv) * W + cu];
+        if (a < 0) continue;
+        // Right and down only (and the diagonals down): each pair once.
+        for (int dv = 0; dv <= g; ++dv) {
+          for (int du = -g; du <= g; ++du) {
+            if (dv == 0 && du <= 0) continue;
+            const int u = cu + du, v = cv + dv;
+            if (u < 0 || u >= W || v >= H) continue;
+            const int b = out->label[static_cast<size_t>(v) * W + u];
+            if (b < 0 || b == a) continue;
+            keys.push_back(static_cast<uint64_t>(std::min(a, b)) << 32 |
+                           static_cast<uint32_t>(std::max(a, b)));
+          }
+        }
+      }
+    }
+    std::sort(keys.begin(), keys.end());
+    for (size_t i = 0; i < keys.size();) {
+      size_t j = i;
+      while (j < keys.size() && keys[j] == keys[i]) ++j;
+      pairs.push_back({keys[i], static_cast<int>(j - i)});
+      i = j;
+    }
+  }
+  if (pairs.empty()) return;
+  std::sort(pairs.begin(), pairs.end(),
+            [](const auto& x, const auto& y) { return x.second > y.second; });
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  std::vector<Moments> moments(n);
+  std::vector<Eigen::Vector3d> normal(n), centroid(n);
+  for (int i = 0; i < n; ++i) {
+    for (const Eigen::Vector3d& p : out->patches[i].points) moments[i].Add(p);
+    normal[i] = out->patches[i].normal;
+    centroid[i] = out->patches[i].centroid;
+  }
+  const double cos_max = std::cos(o.merge_angle_deg * M_PI / 180.0);
+  bool merged = false;
+  for (const auto& [key, count] : pairs) {
+    const int a = Root(parent, static_cast<int>(key >> 32)),
+              b = Root(parent, static_cast<int>(key & 0xffffffffu));
+    if (a == b) continue;
+    if (normal[a].dot(normal[b]) < cos_max) continue;
+    if (std::abs(normal[a].dot(centroid[b] - centroid[a])) > tolerance(centroid[b].z()) ||
+        std::abs(normal[b].dot(centroid[a] - centroid[b])) > tolerance(centroid[a].z())) {
+      continue;
+    }
+    parent[b] = a;
+    moments[a].n += moments[b].n;
+    moments[a].s += moments[b].s;
+    moments[a].ss += moments[b].ss;
+    Eigen::Vector3d eig;
+    moments[a].Fit(&normal[a], &centroid[a], &eig);
+    merged = true;
+  }
+  if (!merged) return;
+  // Renumber: each root keeps the first id among its members.
+  std::vector<int> new_id(n, -1);
+  std::vector<PlanarPatch> patches;
+  for (int i = 0; i < n; ++i) {
+    const int root = Root(parent, i);
+    if (new_id[root] < 0) {
+      new_id[root] = static_cast<int>(patches.size());
+      patches.emplace_back();
+    }
+    new_id[i] = new_id[root];
+    PlanarPatch& p = patches[new_id[i]];
+    PlanarPatch& from = out->patches[i];
+    p.touches_border |= from.touches_border;
+    p.points.insert(p.points.end(), from.points.begin(), from.points.end());
+  }
+  for (PlanarPatch& p : patches) {
+    Moments all;
+    for (const Eigen::Vector3d& q : p.points) all.Add(q);
+    Eigen::Vector3d eig;
+    all.Fit(&p.normal, &p.centroid, &eig);
+    p.rms_m = std::sqrt(eig(0));
+  }
+  for (int& l : out->label) {
+    if (l >= 0) l = new_id[l];
+  }
+  out->patches = std::move(patches);
+}
+
 }  // namespace
 
 absl::Status PlanarPatchOptions::Validate() const {
@@ -41,13 +152,17 @@ absl::Status PlanarPatchOptions::Validate() const {
       !(max_curvature > 0.0 && max_curvature < 1.0 / 3.0) ||
       !(max_normal_angle_deg > 0.0 && max_normal_angle_deg < 90.0) ||
       !(plane_tolerance_base_m > 0.0 && plane_tolerance_base_m < 0.1) ||
-      !(plane_tolerance_per_m2 >= 0.0 && plane_tolerance_per_m2 < 0.1) || min_cells < 4) {
+      !(plane_tolerance_per_m2 >= 0.0 && plane_tolerance_per_m2 < 0.1) || min_cells < 4 ||
+      merge_gap_cells < 0 || merge_gap_cells > 8 ||
+      !(merge_angle_deg > 0.0 && merge_angle_deg < 90.0)) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "planar patch options out of range: step_px=", step_px, " [1, 8], window_cells=",
-        window_cells, " [1, 8], max_curvature=", max_curvature, " (0, 1/3), max_normal_angle_deg=",
-        max_normal_angle_deg, " (0, 90), plane_tolerance_base_m=", plane_tolerance_base_m,
-        " (0, 0.1), plane_tolerance_per_m2=", plane_tolerance_per_m2, " [0, 0.1), min_cells=",
-        min_cells, " >= 4"));
+        "planar patch options out of range: step_px=", step_px,
+        " [1, 8], window_cells=", window_cells, " [1, 8], max_curvature=", max_curvature,
+        " (0, 1/3), max_normal_angle_deg=", max_normal_angle_deg,
+        " (0, 90), plane_tolerance_base_m=", plane_tolerance_base_m,
+        " (0, 0.1), plane_tolerance_per_m2=", plane_tolerance_per_m2,
+        " [0, 0.1), min_cells=", min_cells, " >= 4, merge_gap_cells=", merge_gap_cells,
+        " [0, 8], merge_angle_deg=", merge_angle_deg, " (0, 90)"));
   }
   return absl::OkStatus();
 }
@@ -210,6 +325,7 @@ PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOpt
     out.patches.push_back(std::move(patch));
   }
   for (int& l : out.label) l = std::max(l, -1);
+  if (o.merge_gap_cells > 0) MergeCoplanarPatches(o, tolerance, &out);
   return out;
 }
 

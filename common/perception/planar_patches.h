@@ -33,6 +33,14 @@ struct PlanarPatchOptions {
   double plane_tolerance_per_m2 = 0.003;
   // Regions with fewer cells are dropped. Count.
   int min_cells = 12;
+  // Patches within this many cells of each other whose fitted planes agree
+  // (normals within merge_angle_deg, each centroid on the other's plane
+  // within the tolerance above) are one patch: a face that noise broke up
+  // (generated stereo frames at 1.5-2.3 m: a carton top in four pieces
+  // whose fitted normals differ by 7-12 degrees). Cells (0: no merging) and
+  // degrees.
+  int merge_gap_cells = 2;
+  double merge_angle_deg = 14.0;
 
   absl::Status Validate() const;
 };

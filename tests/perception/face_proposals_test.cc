@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "common/perception/planar_patches.h"
@@ -117,6 +118,33 @@ TEST(PlanarPatchesTest, TheLayerTopIsOnePatchOnItsPlane) {
   const double w = std::max(rect.width, rect.height), h = std::min(rect.width, rect.height);
   EXPECT_NEAR(w, f.width, 0.01);
   EXPECT_NEAR(h, f.height, 0.01);
+}
+
+// A layer top broken by a strip of missing returns one cell wide (as noise
+// breaks a stereo camera's faces into pieces) is two regions; their fitted
+// planes agree, so they are one patch again (merge_gap_cells), its outline
+// the whole layer's; with merging off, two patches.
+TEST(PlanarPatchesTest, PiecesOfOneFaceOnOnePlaneAreOnePatch) {
+  LayerFrame f;
+  f.Render();
+  const CameraIntrinsics& k = f.image.camera;
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 318; u < 322; ++u) {
+      f.image.z[static_cast<size_t>(v) * k.width + u] = std::numeric_limits<float>::quiet_NaN();
+    }
+  }
+  PlanarPatchOptions o;
+  const PlanarPatches merged = SegmentPlanarPatches(f.image, o);
+  const int left = merged.PatchAt(300, 240), right = merged.PatchAt(340, 240);
+  ASSERT_GE(left, 0);
+  EXPECT_EQ(left, right);
+  const PlaneRectangle rect = OutlineRectangle(merged.patches[left]);
+  EXPECT_NEAR(std::max(rect.width, rect.height), f.width, 0.02);
+  o.merge_gap_cells = 0;
+  const PlanarPatches apart = SegmentPlanarPatches(f.image, o);
+  ASSERT_GE(apart.PatchAt(300, 240), 0);
+  ASSERT_GE(apart.PatchAt(340, 240), 0);
+  EXPECT_NE(apart.PatchAt(300, 240), apart.PatchAt(340, 240));
 }
 
 // Expects each pose to sit on one tile of the layer (tile centres at
