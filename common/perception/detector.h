@@ -48,6 +48,10 @@ struct AcceptanceOptions {
   double max_grasp_view_angle_deg = 60.0;
   // The grasp face must project this far inside the image. Pixels.
   double border_margin_px = 3.0;
+  // ... unless every side of it was found where the face ends (free or a
+  // seam, with a free side on each axis): then a corner out of view hides
+  // nothing about where the box is. False: every face in view, whole.
+  bool measured_face_may_leave_view = true;
   // Two accepted boxes may not overlap by more than this (each is shrunk by
   // it before the overlap test). Metres.
   double overlap_margin_m = 0.015;

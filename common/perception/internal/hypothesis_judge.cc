@@ -94,6 +94,20 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
                     0.0, 1.0);
 }
 
+namespace {
+
+// Every side of the grasp face measured where the face ends (free or a
+// seam), with a free side on each axis (a seam gives a position but no
+// turn): the face is pinned down though a corner of it lies out of view.
+bool PinnedOnEverySide(const std::array<SideKind, 4>& sides) {
+  auto ends = [](SideKind k) { return k == SideKind::kFree || k == SideKind::kSeam; };
+  return std::all_of(sides.begin(), sides.end(), ends) &&
+         (sides[0] == SideKind::kFree || sides[1] == SideKind::kFree) &&
+         (sides[2] == SideKind::kFree || sides[3] == SideKind::kFree);
+}
+
+}  // namespace
+
 HypothesisJudge::HypothesisJudge(const DepthImage& depth, const DetectorOptions& options,
                                  const CancelToken* cancel)
     : depth_(depth), options_(options), symmetries_(BoxSymmetries(options.box)), cancel_(cancel) {}
@@ -171,7 +185,9 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   const double score = JudgeRefined(cand.evidence, cand.refinement, options_.box, grasp,
                                     options_.acceptance, reason);
   if (score < 0.0) return false;
-  if (!GraspFaceInView(cand.box.camera_T_box, grasp, options_.acceptance.border_margin_px)) {
+  if (!GraspFaceInView(cand.box.camera_T_box, grasp, options_.acceptance.border_margin_px) &&
+      !(options_.acceptance.measured_face_may_leave_view &&
+        PinnedOnEverySide(cand.refinement.sides))) {
     *reason = "grasp face cut by the image border";
     return false;
   }
@@ -195,7 +211,8 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
 
 // A face cut by the image border cannot be checked to its end (and a
 // gripper aimed at its centre may miss the box): such boxes are not
-// returned.
+// returned, unless every side was found where the face ends
+// (PinnedOnEverySide).
 bool HypothesisJudge::GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face,
                                       double margin) const {
   const int f = static_cast<int>(face);
