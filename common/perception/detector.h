@@ -33,8 +33,9 @@ struct AcceptanceOptions {
   // Share of the grasp face that may be hidden by something in front. Unitless.
   double max_grasp_occluded = 0.25;
   // Largest share of the box's rendered pixels hidden by something in front
-  // of it. Unitless.
-  double max_occluded = 0.3;
+  // of it (a box pushed through the floor or a neighbour hides most of
+  // itself; a real box in a heap under others up to a third). Unitless.
+  double max_occluded = 0.4;
   // Largest share of rendered pixels seen through the box (free space or
   // points inside its volume where the box would be). Unitless.
   double max_see_through = 0.05;
