@@ -272,8 +272,12 @@ class SeamScan {
     const auto [nc, sc] = Window(c - w_ / 2, c + w_ / 2);
     const auto [nl, sl] = Window(c - f1_, c - f0_);
     const auto [nr, sr] = Window(c + f0_, c + f1_);
-    const double ec = ExpectedIn(c - w_ / 2, c + w_ / 2);
-    const double ef = ExpectedIn(c - f1_, c - f0_) + ExpectedIn(c + f0_, c + f1_);
+    // The pixels whose ray meets the plane in each window (what a fully seen
+    // face would give), and how many of them returned a point on it.
+    const auto [pc, hc] = PixelsIn(c - w_ / 2, c + w_ / 2);
+    const auto [pl, hl] = PixelsIn(c - f1_, c - f0_);
+    const auto [pr, hr] = PixelsIn(c + f0_, c + f1_);
+    const double ec = pc, ef = pl + pr;
     if (nl < 10 || nr < 10 || ec < 5 || ef < 10) return std::nullopt;
     // Share of the pixels that should see the plane and do, at the centre
     // against the flanks: the pixel grid's own pattern cancels out.
@@ -296,10 +300,7 @@ class SeamScan {
       // Counted on the pixels, not the points: a groove displaces points
       // sideways (a deeper point on a slanted ray lands further out) and
       // thins them on one flank without any return missing.
-      const auto [pc, hc] = PixelsIn(c - w_ / 2, c + w_ / 2);
-      const auto [pl, hl] = PixelsIn(c - f1_, c - f0_);
-      const auto [pr, hr] = PixelsIn(c + f0_, c + f1_);
-      const double missing_c = 1.0 - hc / pc, missing_f = 1.0 - (hl + hr) / (pl + pr);
+      const double missing_c = 1.0 - hc / pc, missing_f = 1.0 - (hl + hr) / ef;
       const double excess = (pc - hc) - pc * missing_f;
       const double sigma = std::sqrt(pc * std::max(missing_f, 0.005) + 1.0);
       sparse_strength =
@@ -390,7 +391,6 @@ class SeamScan {
   std::pair<double, double> PixelsIn(double lo, double hi) const {
     return grid_.Window(lo, hi, spread_);
   }
-  double ExpectedIn(double lo, double hi) const { return PixelsIn(lo, hi).first; }
 
   const RefinementOptions& o_;
   std::vector<Row> rows_;
@@ -476,7 +476,7 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
   if (inner < 10) return m;  // hidden or cut: no say
   // Something in front of the plane just past the side: the face may go on
   // underneath it, so the side is not where the face ends.
-  int in_front = 0;  // lines on which anything stands in front of the plane there
+  int in_front = 0;
   for (const FacePoint& p : front) {
     const double across = sign * (along_a ? p.a : p.b);
     const double along = along_a ? p.b : p.a;

@@ -117,7 +117,11 @@ void MergeCoplanarPatches(const PlanarPatchOptions& o, const Tolerance& toleranc
     merged = true;
   }
   if (!merged) return;
-  // Renumber: each root keeps the first id among its members.
+  // Renumber: each root keeps the first id among its members. A patch
+  // joined with none is kept as it is; a joined one is refitted on all its
+  // points.
+  std::vector<int> members(n, 0);
+  for (int i = 0; i < n; ++i) ++members[Root(parent, i)];
   std::vector<int> new_id(n, -1);
   std::vector<PlanarPatch> patches;
   for (int i = 0; i < n; ++i) {
@@ -129,10 +133,16 @@ void MergeCoplanarPatches(const PlanarPatchOptions& o, const Tolerance& toleranc
     new_id[i] = new_id[root];
     PlanarPatch& p = patches[new_id[i]];
     PlanarPatch& from = out->patches[i];
+    if (members[root] == 1) {
+      p = std::move(from);
+      continue;
+    }
     p.touches_border |= from.touches_border;
     p.points.insert(p.points.end(), from.points.begin(), from.points.end());
   }
-  for (PlanarPatch& p : patches) {
+  for (int i = 0; i < n; ++i) {
+    if (Root(parent, i) != i || members[i] == 1) continue;
+    PlanarPatch& p = patches[new_id[i]];
     Moments all;
     for (const Eigen::Vector3d& q : p.points) all.Add(q);
     Eigen::Vector3d eig;
@@ -200,15 +210,25 @@ PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOpt
   // Integral images of the point moments: 1, x, y, z, xx, xy, xz, yy, yz, zz.
   constexpr int kM = 10;
   std::vector<double> integral(static_cast<size_t>(W + 1) * (H + 1) * kM, 0.0);
-  auto at = [&](int cu, int cv) { return &integral[(static_cast<size_t>(cv) * (W + 1) + cu) * kM]; };
+  auto at = [&](int cu, int cv) {
+    return &integral[(static_cast<size_t>(cv) * (W + 1) + cu) * kM];
+  };
   for (int cv = 0; cv < H; ++cv) {
     double row[kM] = {};
     for (int cu = 0; cu < W; ++cu) {
       const size_t i = static_cast<size_t>(cv) * W + cu;
       if (valid[i]) {
         const Eigen::Vector3d& p = point[i];
-        const double m[kM] = {1, p.x(), p.y(), p.z(), p.x() * p.x(), p.x() * p.y(),
-                              p.x() * p.z(), p.y() * p.y(), p.y() * p.z(), p.z() * p.z()};
+        const double m[kM] = {1,
+                              p.x(),
+                              p.y(),
+                              p.z(),
+                              p.x() * p.x(),
+                              p.x() * p.y(),
+                              p.x() * p.z(),
+                              p.y() * p.y(),
+                              p.y() * p.z(),
+                              p.z() * p.z()};
         for (int j = 0; j < kM; ++j) row[j] += m[j];
       }
       double* dst = at(cu + 1, cv + 1);
@@ -225,8 +245,8 @@ PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOpt
     for (int cu = r; cu < W - r; ++cu) {
       const size_t i = static_cast<size_t>(cv) * W + cu;
       if (!valid[i]) continue;
-      const double *a = at(cu - r, cv - r), *b = at(cu + r + 1, cv - r), *c = at(cu - r, cv + r + 1),
-                   *d = at(cu + r + 1, cv + r + 1);
+      const double *a = at(cu - r, cv - r), *b = at(cu + r + 1, cv - r),
+                   *c = at(cu - r, cv + r + 1), *d = at(cu + r + 1, cv + r + 1);
       double m[kM];
       for (int j = 0; j < kM; ++j) m[j] = d[j] - b[j] - c[j] + a[j];
       if (m[0] < min_window) continue;

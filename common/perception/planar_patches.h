@@ -46,7 +46,7 @@ struct PlanarPatchOptions {
 };
 
 struct PlanarPatch {
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, towards the camera
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   // unit, towards the camera
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // metres, camera frame
   double rms_m = 0.0;                                  // of the points about the plane
   std::vector<Eigen::Vector3d> points;                 // one per cell, camera frame
