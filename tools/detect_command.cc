@@ -78,6 +78,11 @@ constexpr char kHelp[] =
     "                       boxes; true for cells that see only layers of known boxes)\n"
     "  --size_tolerance M   how far a box may be off its nominal size and still be it\n"
     "                       (unset: each stage's own tolerance, 1-2.5 cm)\n"
+    "  --side_allowance M   on a box's faces but the one it shows most, depth up to M\n"
+    "                       behind the tolerance is no evidence either way (time-of-\n"
+    "                       flight multipath in concave creases; 0.025; 0: off)\n"
+    "  --max_declined N     report the N strongest declined candidates with their\n"
+    "                       reasons (8; 0-1000)\n"
     "  --kdtree             unorganized clouds: score edges over a k-d tree (the\n"
     "                       paper's way) instead of projecting onto the camera grid\n"
     "  --quiet              print nothing but errors\n";
@@ -98,24 +103,27 @@ absl::Status Run(const CommandArgs& args) {
     load.intrinsics = *intrinsics;
     options.camera = *intrinsics;
   }
-  for (absl::Status s : {args.SetDouble("radius", &options.edge_points.radius_m),
-                         args.SetDouble("threshold", &options.edge_points.threshold),
-                         args.SetInt("samples", &options.edge_points.max_samples),
-                         args.SetDouble("ransac_threshold", &options.segments.ransac_threshold_m),
-                         args.SetDouble("meet_distance", &options.clubbing.meet_distance_m),
-                         args.SetInt("threads", &options.num_threads),
-                         args.SetInt("coarse_step", &options.edge_points.coarse_step),
-                         args.SetDouble("lattice_radius", &options.edge_lattice_radius_px),
-                         args.SetBool("denoise", &options.edge_points.denoise),
-                         args.SetBool("faces", &options.face_proposals),
-                         args.SetBool("layer_check", &options.faces.check_layer_tiling),
-                         args.SetBool("floor_check", &options.floor_check),
-                         args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
-                         args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
-                         args.SetDouble("sparse_seam", &options.refinement.sparse_seam_missing),
-                         args.SetDouble("eroded_faces", &options.faces.min_eroded_share),
-                         args.SetInt("merge_patches", &options.faces.patches.merge_gap_cells),
-                         args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides)}) {
+  for (absl::Status s :
+       {args.SetDouble("radius", &options.edge_points.radius_m),
+        args.SetDouble("threshold", &options.edge_points.threshold),
+        args.SetInt("samples", &options.edge_points.max_samples),
+        args.SetDouble("ransac_threshold", &options.segments.ransac_threshold_m),
+        args.SetDouble("meet_distance", &options.clubbing.meet_distance_m),
+        args.SetInt("threads", &options.num_threads),
+        args.SetInt("coarse_step", &options.edge_points.coarse_step),
+        args.SetDouble("lattice_radius", &options.edge_lattice_radius_px),
+        args.SetBool("denoise", &options.edge_points.denoise),
+        args.SetBool("faces", &options.face_proposals),
+        args.SetBool("layer_check", &options.faces.check_layer_tiling),
+        args.SetBool("floor_check", &options.floor_check),
+        args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
+        args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
+        args.SetDouble("sparse_seam", &options.refinement.sparse_seam_missing),
+        args.SetDouble("eroded_faces", &options.faces.min_eroded_share),
+        args.SetInt("merge_patches", &options.faces.patches.merge_gap_cells),
+        args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides),
+        args.SetInt("max_declined", &options.max_declined),
+        args.SetDouble("side_allowance", &options.evidence.side_face_allowance_m)}) {
     if (!s.ok()) return s;
   }
   if (get("size_tolerance")) {
@@ -210,7 +218,9 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "eroded_faces",
                                                        "merge_patches",
                                                        "tile_uncued",
-                                                       "size_tolerance"},
+                                                       "size_tolerance",
+                                                       "max_declined",
+                                                       "side_allowance"},
                                                       {"quiet", "kdtree"});
   if (!args.ok()) {
     std::fprintf(stderr, "cornerpose detect: %s\n\n%s",

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "common/perception/box_pose.h"
@@ -22,6 +24,10 @@ absl::Status EvidenceOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("outline_margin_m=", outline_margin_m, " is outside [0, 0.1] m"));
   }
+  if (!(side_face_allowance_m >= 0.0 && side_face_allowance_m <= 0.1)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("side_face_allowance_m=", side_face_allowance_m, " is outside [0, 0.1] m"));
+  }
   if (max_samples < 10 || max_samples > 10000000) {
     return absl::InvalidArgumentError(
         absl::StrCat("evidence max_samples=", max_samples, " is outside [10, 1e7]"));
@@ -32,6 +38,39 @@ absl::Status EvidenceOptions::Validate() const {
   }
   return absl::OkStatus();
 }
+
+namespace {
+
+// Area of a convex quad clipped to the rectangle [x0, x1] x [y0, y1]
+// (Sutherland-Hodgman, one edge of the rectangle at a time). Pixels^2.
+double ClippedArea(const std::array<Eigen::Vector2d, 4>& quad, double x0, double y0, double x1,
+                   double y1) {
+  std::vector<Eigen::Vector2d> poly(quad.begin(), quad.end()), next;
+  // Each clip keeps the side where s * p[axis] <= s * limit.
+  const std::array<std::tuple<int, double, double>, 4> clips = {
+      {{0, -1.0, x0}, {0, 1.0, x1}, {1, -1.0, y0}, {1, 1.0, y1}}};
+  for (const auto& [axis, s, limit] : clips) {
+    next.clear();
+    for (size_t i = 0; i < poly.size(); ++i) {
+      const Eigen::Vector2d& p = poly[i];
+      const Eigen::Vector2d& q = poly[(i + 1) % poly.size()];
+      const bool p_in = s * p[axis] <= s * limit, q_in = s * q[axis] <= s * limit;
+      if (p_in) next.push_back(p);
+      if (p_in != q_in) next.push_back(p + (q - p) * ((limit - p[axis]) / (q[axis] - p[axis])));
+    }
+    poly.swap(next);
+    if (poly.empty()) return 0.0;
+  }
+  double area = 0.0;
+  for (size_t i = 0; i < poly.size(); ++i) {
+    const Eigen::Vector2d& p = poly[i];
+    const Eigen::Vector2d& q = poly[(i + 1) % poly.size()];
+    area += p.x() * q.y() - q.x() * p.y();
+  }
+  return 0.5 * std::abs(area);
+}
+
+}  // namespace
 
 BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_T_box,
                        const BoxDims& dims, const EvidenceOptions& options) {
@@ -130,6 +169,19 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
     }
     faces.push_back(f);
   }
+  // The face the box shows most (the largest area of its quad inside the
+  // image, as the grasp face is the one with the most pixels): the others
+  // get the side-face allowance.
+  int main_face = -1;
+  double main_area = -1.0;
+  for (const VisibleFace& face : faces) {
+    const double area =
+        ClippedArea(face.quad, ua, va, ub + 1.0, vb + 1.0);  // the rectangle is inside the image
+    if (area > main_area) {
+      main_area = area;
+      main_face = face.index;
+    }
+  }
   std::array<int, 6> face_px{};
   for (int v = va; v <= vb; v += step) {
     const double ray_yv = ray_y[v - va];
@@ -151,6 +203,11 @@ BoxEvidence MeasureBox(const DepthImage& depth, const Eigen::Isometry3d& camera_
             options.depth_tolerance_base_m + options.depth_tolerance_per_m2 * z_model * z_model;
         const bool disagrees = std::isnan(z) || z > z_model + tol;
         if (disagrees && near_outline(u, v)) {
+          ++f.border;
+          continue;
+        }
+        if (face.index != main_face && z > z_model + tol &&
+            z <= z_model + tol + options.side_face_allowance_m) {
           ++f.border;
           continue;
         }

@@ -32,6 +32,16 @@ struct EvidenceOptions {
   // radius r_s (the scale at which the edge detector resolves an outline).
   // [0, 0.1]; 0 counts every pixel.
   double outline_margin_m = 0.01;
+  // On the faces other than the one the box shows most (its sides, seen
+  // obliquely and meeting the floor or a neighbour in concave creases), a
+  // pixel up to this much further behind than the tolerance is neither
+  // agreement nor see-through but `border`: a time-of-flight camera's
+  // multipath biases the depth near concave creases by up to a few
+  // centimetres away from the camera (a real isolated carton's sides read
+  // 6-8 % "seen through" without it). A box placed where there is free
+  // space shows what lies behind much further back, or on its main face.
+  // Metres, [0, 0.1]; 0 treats every face alike.
+  double side_face_allowance_m = 0.025;
 
   absl::Status Validate() const;
 };
