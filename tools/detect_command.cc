@@ -81,6 +81,8 @@ constexpr char kHelp[] =
     "  --side_allowance M   on a box's faces but the one it shows most, depth up to M\n"
     "                       behind the tolerance is no evidence either way (time-of-\n"
     "                       flight multipath in concave creases; 0.025; 0: off)\n"
+    "  --border_faces BOOL  a planar patch at the image border no bigger than a face\n"
+    "                       proposes that face (true)\n"
     "  --max_declined N     report the N strongest declined candidates with their\n"
     "                       reasons (8; 0-1000)\n"
     "  --kdtree             unorganized clouds: score edges over a k-d tree (the\n"
@@ -123,6 +125,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetInt("merge_patches", &options.faces.patches.merge_gap_cells),
         args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides),
         args.SetInt("max_declined", &options.max_declined),
+        args.SetBool("border_faces", &options.faces.propose_at_border),
         args.SetDouble("side_allowance", &options.evidence.side_face_allowance_m)}) {
     if (!s.ok()) return s;
   }
@@ -220,7 +223,8 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "tile_uncued",
                                                        "size_tolerance",
                                                        "max_declined",
-                                                       "side_allowance"},
+                                                       "side_allowance",
+                                                       "border_faces"},
                                                       {"quiet", "kdtree"});
   if (!args.ok()) {
     std::fprintf(stderr, "cornerpose detect: %s\n\n%s",

@@ -168,8 +168,11 @@ int Run(const CommandArgs& args) {
     std::printf("; nearest face proposal %.0f mm", 1000.0 * nearest);
     if (patch >= 0) {
       const PlaneRectangle r = OutlineRectangle(faces.patches.patches[patch]);
-      std::printf("; patch %d outline %.3f x %.3f m (%zu cells)", patch, r.width, r.height,
-                  faces.patches.patches[patch].points.size());
+      const PlanarPatch& pp = faces.patches.patches[patch];
+      std::printf("; patch %d outline %.3f x %.3f m (%zu cells%s, %.0f deg to the view)", patch,
+                  r.width, r.height, pp.points.size(), pp.touches_border ? ", at the border" : "",
+                  std::acos(std::clamp(pp.normal.dot(-pp.centroid.normalized()), -1.0, 1.0)) *
+                      180.0 / M_PI);
     } else {
       std::printf("; no patch at its centre");
     }

@@ -205,10 +205,18 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     const double area = patch.points.size() * cell_m * cell_m;
     if (area < 0.5 * smallest_face) continue;
     if (patch.normal.dot(-patch.centroid.normalized()) < cos_view) continue;
-    // An outline cut by the image border says nothing about where the face
-    // ends.
-    if (patch.touches_border) continue;
     const PlaneRectangle rect = OutlineRectangle(patch);
+    // An outline cut by the image border says nothing about where a layer
+    // ends. One no bigger than a face may still be that face whole (a box
+    // near the edge of the view, its patch within a window of the border):
+    // it proposes faces of the box on it, never a layer, and the judge
+    // decides whether every side was seen (AcceptanceOptions).
+    const double largest_side = sorted[2] + o.size_tolerance_m;
+    const bool at_border = patch.touches_border;
+    if (at_border &&
+        (!o.propose_at_border || rect.width > largest_side || rect.height > largest_side)) {
+      continue;
+    }
     // A patch filling little of its outline is no face or layer (a floor
     // around things, an L of two boxes' sides).
     if (area < 0.5 * rect.width * rect.height) continue;
@@ -239,6 +247,7 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     // The tiles a box on this patch may be (every tile of the tilings in
     // play, on the patch or not: a notch is where a box was taken).
     auto in_play = [&](std::initializer_list<FaceTiling> in) {
+      if (at_border) return;
       // Fill: the patch's area over that of the tiles on it (a layer with
       // boxes taken away is still full where it is); the least of the
       // tilings in play.
@@ -274,8 +283,7 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
       // face in each corner of the outline, for each way one fits in it;
       // only for an outline about one face in size (a bigger one is a
       // floor, a wall, a layer cut by the image border).
-      const double largest = sorted[2] + o.size_tolerance_m;
-      if (rect.width > largest || rect.height > largest) continue;
+      if (rect.width > largest_side || rect.height > largest_side) continue;
       for (int n = 0; n < 3; ++n) {
         const int a = (n + 1) % 3, b = (n + 2) % 3;
         for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {

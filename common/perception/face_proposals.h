@@ -34,6 +34,11 @@ struct FaceProposalOptions {
   // both sides proposes the face centred on it (its rim taken in by the
   // segmentation); 0 proposes nothing from such outlines. Unitless.
   double min_eroded_share = 0.65;
+  // A patch within a normal window of the image border whose outline is no
+  // bigger than one face proposes the faces that fit it (never a layer's
+  // tiles); false skips every such patch. The judge still requires a face
+  // leaving the view to be measured on every side.
+  bool propose_at_border = true;
   // Patches seen more obliquely than this are not proposed from. Degrees.
   double max_view_angle_deg = 65.0;
   // A patch with more tiles than this is not tiled. Count.

@@ -208,6 +208,42 @@ TEST(FaceProposalsTest, AnOutlineALittleSmallerThanAFaceProposesItCentred) {
   EXPECT_EQ(lying_centred(FaceProposalOptions{}), 0);
 }
 
+// A carton's top within a few pixels of the image border (its patch within
+// a normal window of the border) is that face whole: it proposes the face;
+// a layer cut by the border proposes nothing and is no layer.
+TEST(FaceProposalsTest, AFaceAtTheImageBorderProposesItButALayerThereDoesNot) {
+  LayerFrame f;
+  f.yaw_deg = 0.0;
+  f.width = 0.30;
+  f.height = 0.20;
+  // Its right side 4 px inside the image (fx 525, cx 319.5, at kTop).
+  const double right_edge_x = (636.0 - 319.5) / 525.0 * kTop;
+  f.centre = Eigen::Vector2d(right_edge_x - 0.15, 0.0);
+  f.Render();
+  auto centred = [&](const FaceProposals& p) {
+    int n = 0;
+    for (const Eigen::Isometry3d& pose : p.poses) {
+      const Eigen::Vector2d q = f.ToLayer(pose.translation().x(), pose.translation().y());
+      n += q.norm() < 0.01 && std::abs(pose.linear().col(2).z()) > 0.95;
+    }
+    return n;
+  };
+  const FaceProposals at_border = ProposeFromFaces(f.image, kCarton, FaceProposalOptions{});
+  EXPECT_GE(centred(at_border), 1);
+  EXPECT_TRUE(at_border.layers.empty());
+  FaceProposalOptions off;
+  off.propose_at_border = false;
+  EXPECT_EQ(centred(ProposeFromFaces(f.image, kCarton, off)), 0);
+  // A 0.9 x 0.4 layer cut by the same border: nothing.
+  f.width = 0.9;
+  f.height = 0.4;
+  f.centre = Eigen::Vector2d(right_edge_x - 0.3, 0.0);
+  f.Render();
+  const FaceProposals layer = ProposeFromFaces(f.image, kCarton, FaceProposalOptions{});
+  EXPECT_TRUE(layer.poses.empty());
+  EXPECT_TRUE(layer.layers.empty());
+}
+
 TEST(FaceProposalsTest, ANotchedLayerProposesOnlyTheTilesThatAreThere) {
   LayerFrame f;
   f.width = 0.9;
