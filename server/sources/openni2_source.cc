@@ -211,6 +211,23 @@ OpenNi2Source::SessionEnd OpenNi2Source::Capture(std::string* reason) {
     *reason = absl::StrCat("cannot start the depth stream: ", OpenNiError());
     return SessionEnd::kFailed;
   }
+  // Torn down in order on every way out: a recording's player first held
+  // in manual mode (no more frames pushed), then the stream stopped and
+  // destroyed, then the device closed. Left to the destructors, OpenNI2's
+  // file player thread could still push a frame into the stream being
+  // destroyed and crash (seen at the end of a recording played once, one
+  // run in seven on a loaded machine).
+  struct Teardown {
+    openni::Device& device;
+    openni::VideoStream& stream;
+    openni::PlaybackControl* playback;
+    ~Teardown() {
+      if (playback != nullptr) playback->setSpeed(-1.0f);
+      stream.stop();
+      stream.destroy();
+      device.close();
+    }
+  } teardown{device, depth, playback};
   const float hfov = depth.getHorizontalFieldOfView();
   const float vfov = depth.getVerticalFieldOfView();
   const bool mirrored = depth.getMirroringEnabled();
