@@ -83,6 +83,8 @@ constexpr char kHelp[] =
     "                       flight multipath in concave creases; 0.025; 0: off)\n"
     "  --border_faces BOOL  a planar patch at the image border no bigger than a face\n"
     "                       proposes that face (true)\n"
+    "  --retry_declined BOOL a pose refined and declined is judged once more when\n"
+    "                       proposed again from another start (true)\n"
     "  --max_declined N     report the N strongest declined candidates with their\n"
     "                       reasons (8; 0-1000)\n"
     "  --kdtree             unorganized clouds: score edges over a k-d tree (the\n"
@@ -126,6 +128,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides),
         args.SetInt("max_declined", &options.max_declined),
         args.SetBool("border_faces", &options.faces.propose_at_border),
+        args.SetBool("retry_declined", &options.retry_declined),
         args.SetDouble("side_allowance", &options.evidence.side_face_allowance_m)}) {
     if (!s.ok()) return s;
   }
@@ -224,7 +227,8 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "size_tolerance",
                                                        "max_declined",
                                                        "side_allowance",
-                                                       "border_faces"},
+                                                       "border_faces",
+                                                       "retry_declined"},
                                                       {"quiet", "kdtree"});
   if (!args.ok()) {
     std::fprintf(stderr, "cornerpose detect: %s\n\n%s",

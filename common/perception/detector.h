@@ -110,6 +110,11 @@ struct DetectorOptions {
   double edge_lattice_radius_px = 5.0;
   // Declined hypotheses reported per frame (the strongest). Count, >= 0.
   int max_declined = 8;
+  // A hypothesis refined and declined may be proposed once more from
+  // another start (a face tile after a corner, a neighbour of a box found
+  // later) and is then judged again: where refinement reads a side depends
+  // a little on where it starts. False: every pose is judged once.
+  bool retry_declined = true;
   // Each confirmed box proposes the boxes that would touch it side by side
   // (pallet layers, where seams leave few edges), neighbour_gap_m apart.
   bool propagate_to_neighbours = true;

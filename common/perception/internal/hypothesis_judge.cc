@@ -115,9 +115,18 @@ HypothesisJudge::HypothesisJudge(const DepthImage& depth, const DetectorOptions&
 void HypothesisJudge::Propose(const Eigen::Isometry3d& camera_T_box, int corners,
                               std::vector<int> segments, bool from_face) {
   if (Seen(camera_T_box)) return;
+  // A pose like one refined and declined before gets one more start: the
+  // refinement's reading of a side can depend on where it starts (a side
+  // read as hidden from one start is free from another), so a later
+  // proposal (a face tile after a corner, a neighbour) is judged once more.
+  bool retry = false;
+  if (const int i = FindLike(second_chance_, camera_T_box); i >= 0) {
+    second_chance_.erase(second_chance_.begin() + i);
+    retry = true;
+  }
   seen_.push_back(camera_T_box);
   ++stats_.proposed;
-  queue_.push_back({camera_T_box, corners, std::move(segments), from_face});
+  queue_.push_back({camera_T_box, corners, std::move(segments), from_face, retry});
 }
 
 std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
@@ -140,6 +149,13 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
       if (refined[i]) {
         declined_.push_back(
             {results[i].box.camera_T_box, results[i].box.score, std::move(reasons[i])});
+        if (options_.retry_declined) {
+          // Its proposed pose may be proposed once more (Propose).
+          if (const int s = FindLike(seen_, queue_[i].camera_T_box); s >= 0 && !queue_[i].retry) {
+            seen_.erase(seen_.begin() + s);
+            second_chance_.push_back(queue_[i].camera_T_box);
+          }
+        }
       }
       continue;
     }
@@ -236,14 +252,22 @@ bool HypothesisJudge::GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace fac
   return true;
 }
 
-bool HypothesisJudge::Seen(const Eigen::Isometry3d& pose) const {
-  for (const Eigen::Isometry3d& s : seen_) {
+int HypothesisJudge::FindLike(const std::vector<Eigen::Isometry3d>& poses,
+                              const Eigen::Isometry3d& pose) const {
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const Eigen::Isometry3d& s = poses[i];
     if ((s.translation() - pose.translation()).norm() > 0.01) continue;
     for (const Eigen::Matrix3d& S : symmetries_) {
-      if ((s.linear() - pose.linear() * S).norm() < 0.06) return true;  // ~2.5 degrees
+      if ((s.linear() - pose.linear() * S).norm() < 0.06) {  // ~2.5 degrees
+        return static_cast<int>(i);
+      }
     }
   }
-  return false;
+  return -1;
+}
+
+bool HypothesisJudge::Seen(const Eigen::Isometry3d& pose) const {
+  return FindLike(seen_, pose) >= 0;
 }
 
 }  // namespace cornerpose::internal

@@ -36,7 +36,8 @@ class HypothesisJudge {
 
   // Queues a pose unless one like it (same place within 1 cm, same
   // orientation up to the box's symmetries) was proposed before: the
-  // corners of one box propose it many times.
+  // corners of one box propose it many times. One that was refined and
+  // declined is queued once more (with retry_declined).
   void Propose(const Eigen::Isometry3d& camera_T_box, int corners, std::vector<int> segments,
                bool from_face = false);
 
@@ -55,6 +56,7 @@ class HypothesisJudge {
     int corners;
     std::vector<int> segments;
     bool from_face;
+    bool retry = false;  // a second start at a pose declined once
   };
   // Evaluates one proposal; false when rejected. `refined` is set when it
   // got as far as refinement; then `reason` says why it was rejected, and
@@ -62,12 +64,18 @@ class HypothesisJudge {
   bool EvaluateOne(const Proposal& p, Candidate* out, bool* refined, std::string* reason) const;
   bool GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face, double margin) const;
   bool Seen(const Eigen::Isometry3d& pose) const;
+  // The index in `poses` of one like `pose` (within 1 cm, axes within
+  // ~2.5 degrees up to the box's symmetries), or -1.
+  int FindLike(const std::vector<Eigen::Isometry3d>& poses, const Eigen::Isometry3d& pose) const;
 
   const DepthImage& depth_;
   const DetectorOptions& options_;
   const std::vector<Eigen::Matrix3d> symmetries_;
   const CancelToken* const cancel_;
   std::vector<Eigen::Isometry3d> seen_;
+  // Proposed poses refined and declined once: one more proposal like one
+  // of them is judged (DetectorOptions::retry_declined).
+  std::vector<Eigen::Isometry3d> second_chance_;
   std::vector<Proposal> queue_;
   HypothesisStats stats_;
   std::vector<DeclinedCandidate> declined_;
