@@ -85,6 +85,8 @@ constexpr char kHelp[] =
     "                       proposes that face (true)\n"
     "  --retry_declined BOOL a pose refined and declined is judged once more when\n"
     "                       proposed again from another start (true)\n"
+    "  --patch_window N     planar patches: a cell's normal from (2N+1)^2 cells of 4 px\n"
+    "                       (2)\n"
     "  --max_declined N     report the N strongest declined candidates with their\n"
     "                       reasons (8; 0-1000)\n"
     "  --kdtree             unorganized clouds: score edges over a k-d tree (the\n"
@@ -129,6 +131,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetInt("max_declined", &options.max_declined),
         args.SetBool("border_faces", &options.faces.propose_at_border),
         args.SetBool("retry_declined", &options.retry_declined),
+        args.SetInt("patch_window", &options.faces.patches.window_cells),
         args.SetDouble("side_allowance", &options.evidence.side_face_allowance_m)}) {
     if (!s.ok()) return s;
   }
@@ -228,7 +231,8 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "max_declined",
                                                        "side_allowance",
                                                        "border_faces",
-                                                       "retry_declined"},
+                                                       "retry_declined",
+                                                       "patch_window"},
                                                       {"quiet", "kdtree"});
   if (!args.ok()) {
     std::fprintf(stderr, "cornerpose detect: %s\n\n%s",

@@ -239,6 +239,16 @@ void DeriveGeometryParameters(double z, double focal_px, DetectorOptions* o) {
   if (o->evidence.outline_margin_m == defaults.evidence.outline_margin_m) {
     o->evidence.outline_margin_m = r / 2.0;
   }
+  // The planar patches' normal window: a wider one (7 x 7 cells) where it
+  // spans at most 0.8 of the box's smallest side at depth z. A noisy
+  // sensor at 2 m (stereo: ~7 mm) makes half the cells of a 5 x 5 window
+  // on a flat face look curved, so faces came out in pieces; a brick's
+  // faces are too narrow for it.
+  PlanarPatchOptions& patches = o->faces.patches;
+  if (patches.window_cells == defaults.faces.patches.window_cells && z > 0.0 && focal_px > 0.0 &&
+      7.0 * patches.step_px <= 0.8 * smallest * focal_px / z) {
+    patches.window_cells = 3;
+  }
 }
 
 absl::Status AcceptanceOptions::Validate() const {

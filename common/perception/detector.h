@@ -146,6 +146,8 @@ void UseFrameCamera(const std::optional<CameraIntrinsics>& frame_camera, Detecto
 // min(0.35 x the box's smallest side, max(0.02 m, 6 pixels at depth z));
 // RANSAC threshold and meeting distance r_s / 2; the segment gap r_s. So a
 // 3 cm edge at 0.6 m gets r_s = 1.05 cm; a carton at 1-2.5 m keeps 2 cm.
+// The planar patches' normal window grows from 5 x 5 to 7 x 7 cells where
+// 7 cells span at most 0.8 of the smallest side at z (cartons, not bricks).
 // `focal_px` is the camera's fx; z in metres (<= 0: unknown, depth term off).
 void DeriveGeometryParameters(double median_depth_m, double focal_px, DetectorOptions* options);
 

@@ -213,5 +213,28 @@ TEST(GeometryParametersTest, SmallBoxesNearGetASmallerDiscAndCallerValuesStay) {
   EXPECT_NEAR(far.edge_points.radius_m, 0.03, 1e-9);  // 6 px at 3 m
 }
 
+TEST(GeometryParametersTest, ThePatchWindowWidensWhereTheBoxIsWideEnough) {
+  // A carton's 15 cm side at 1.8 m (44 px) holds a 7 x 7-cell window (28 px)
+  // within 0.8 of it; a brick's 5.7 cm at 1.5 m (20 px) does not.
+  DetectorOptions carton;
+  carton.box = {0.3, 0.2, 0.15};
+  DeriveGeometryParameters(1.8, 525.0, &carton);
+  EXPECT_EQ(carton.faces.patches.window_cells, 3);
+  DetectorOptions brick;
+  brick.box = {0.19, 0.09, 0.057};
+  DeriveGeometryParameters(1.5, 525.0, &brick);
+  EXPECT_EQ(brick.faces.patches.window_cells, 2);
+  // Unknown depth, or a window the caller set: kept.
+  DetectorOptions unknown;
+  unknown.box = carton.box;
+  DeriveGeometryParameters(0.0, 525.0, &unknown);
+  EXPECT_EQ(unknown.faces.patches.window_cells, 2);
+  DetectorOptions set;
+  set.box = carton.box;
+  set.faces.patches.window_cells = 1;
+  DeriveGeometryParameters(1.8, 525.0, &set);
+  EXPECT_EQ(set.faces.patches.window_cells, 1);
+}
+
 }  // namespace
 }  // namespace cornerpose::testing
