@@ -53,16 +53,6 @@ const char* SideName(SideKind k) {
   return "?";
 }
 
-double MedianDepth(const std::vector<float>& z) {
-  std::vector<float> valid;
-  for (size_t i = 0; i < z.size(); i += 7) {
-    if (std::isfinite(z[i]) && z[i] > 0.0f) valid.push_back(z[i]);
-  }
-  if (valid.empty()) return 0.0;
-  std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
-  return valid[valid.size() / 2];
-}
-
 // Judges one pose as the detector does (first look, refinement, the
 // acceptance test) and prints each step; returns the grasp face.
 BoxFace JudgeOne(const DepthImage& depth, const DetectorOptions& options,
@@ -129,7 +119,7 @@ int Run(const CommandArgs& args) {
   CameraIntrinsics camera = options.camera.value_or(CameraIntrinsics{});
   if (absl::StatusOr<CameraIntrinsics> k = EstimateIntrinsics(*cloud); k.ok()) camera = *k;
   const DepthImage depth = MakeDepthImage(*cloud, camera);
-  DeriveGeometryParameters(MedianDepth(depth.z), camera.fx, &options);
+  DeriveGeometryParameters(MedianDepth(depth), camera.fx, &options);
 
   std::ifstream in(*args.Get("poses"));
   const nlohmann::json doc = nlohmann::json::parse(in, nullptr, false);

@@ -45,26 +45,30 @@ namespace {
 // (Sutherland-Hodgman, one edge of the rectangle at a time). Pixels^2.
 double ClippedArea(const std::array<Eigen::Vector2d, 4>& quad, double x0, double y0, double x1,
                    double y1) {
-  std::vector<Eigen::Vector2d> poly(quad.begin(), quad.end()), next;
+  // Each clip by a half-plane adds at most one corner: 8 at most.
+  std::array<Eigen::Vector2d, 8> poly, next;
+  std::copy(quad.begin(), quad.end(), poly.begin());
+  int n = 4;
   // Each clip keeps the side where s * p[axis] <= s * limit.
   const std::array<std::tuple<int, double, double>, 4> clips = {
       {{0, -1.0, x0}, {0, 1.0, x1}, {1, -1.0, y0}, {1, 1.0, y1}}};
   for (const auto& [axis, s, limit] : clips) {
-    next.clear();
-    for (size_t i = 0; i < poly.size(); ++i) {
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
       const Eigen::Vector2d& p = poly[i];
-      const Eigen::Vector2d& q = poly[(i + 1) % poly.size()];
+      const Eigen::Vector2d& q = poly[(i + 1) % n];
       const bool p_in = s * p[axis] <= s * limit, q_in = s * q[axis] <= s * limit;
-      if (p_in) next.push_back(p);
-      if (p_in != q_in) next.push_back(p + (q - p) * ((limit - p[axis]) / (q[axis] - p[axis])));
+      if (p_in) next[m++] = p;
+      if (p_in != q_in) next[m++] = p + (q - p) * ((limit - p[axis]) / (q[axis] - p[axis]));
     }
-    poly.swap(next);
-    if (poly.empty()) return 0.0;
+    poly = next;
+    n = m;
+    if (n == 0) return 0.0;
   }
   double area = 0.0;
-  for (size_t i = 0; i < poly.size(); ++i) {
+  for (int i = 0; i < n; ++i) {
     const Eigen::Vector2d& p = poly[i];
-    const Eigen::Vector2d& q = poly[(i + 1) % poly.size()];
+    const Eigen::Vector2d& q = poly[(i + 1) % n];
     area += p.x() * q.y() - q.x() * p.y();
   }
   return 0.5 * std::abs(area);

@@ -78,6 +78,17 @@ bool QuadRowSpan(const std::array<Eigen::Vector2d, 4>& quad, double y, double* x
   return *x0 < *x1;
 }
 
+double MedianDepth(const DepthImage& depth) {
+  const std::vector<float>& z = depth.z;
+  std::vector<float> valid;
+  for (size_t i = 0; i < z.size(); i += 7) {
+    if (std::isfinite(z[i]) && z[i] > 0.0f) valid.push_back(z[i]);
+  }
+  if (valid.empty()) return 0.0;
+  std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
+  return valid[valid.size() / 2];
+}
+
 DepthImage MakeDepthImage(const PointCloud& cloud, const CameraIntrinsics& k) {
   DepthImage image;
   image.camera = k;

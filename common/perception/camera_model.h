@@ -59,6 +59,10 @@ struct DepthImage {
 };
 DepthImage MakeDepthImage(const PointCloud& cloud, const CameraIntrinsics& k);
 
+// Median depth of the image's valid pixels (every 7th), metres; 0 when none.
+// The depth the geometry rule (DeriveGeometryParameters) works at.
+double MedianDepth(const DepthImage& depth);
+
 // Projects an unorganized cloud into an organized one through `k` (nearest
 // point per pixel). Organized clouds are returned unchanged.
 PointCloud OrganizeByProjection(const PointCloud& cloud, const CameraIntrinsics& k);

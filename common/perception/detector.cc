@@ -52,17 +52,6 @@ const PointCloud& SanitizeCloud(const PointCloud& cloud, PointCloud* storage) {
   return *storage;
 }
 
-// Median depth of the valid points (every 7th), 0 when none.
-double MedianDepth(const std::vector<float>& z) {
-  std::vector<float> valid;
-  for (size_t i = 0; i < z.size(); i += 7) {
-    if (std::isfinite(z[i]) && z[i] > 0.0f) valid.push_back(z[i]);
-  }
-  if (valid.empty()) return 0.0;
-  std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
-  return valid[valid.size() / 2];
-}
-
 void ApplySizeTolerance(double t, DetectorOptions* o) {
   o->faces.size_tolerance_m = t;
   o->refinement.tile_tolerance_m = 2.0 * t / 3.0;
@@ -388,7 +377,7 @@ absl::Status PrepareFrame(const PointCloud& input, const DetectorOptions& option
     f->work = &cloud;  // the input or f->sanitized
   }
   f->depth = MakeDepthImage(*f->work, f->camera);
-  const double median_z = MedianDepth(f->depth.z);
+  const double median_z = MedianDepth(f->depth);
   if (options.parameters_from_geometry) DeriveGeometryParameters(median_z, f->camera.fx, &options);
   if (options.size_tolerance_m) ApplySizeTolerance(*options.size_tolerance_m, &options);
   if (options.edge_lattice_radius_px > 0.0) {
