@@ -62,16 +62,6 @@ class OrganizedScorer {
         radius2_(static_cast<float>(options.radius_m * options.radius_m)),
         pattern_(UnitDiscPattern(std::max(options.max_samples, 1))) {
     BuildOffsets(options.max_samples, &offsets_);
-    // The points as three planes: a neighbour's coordinates are then three
-    // loads at one offset, and the loops over them vectorize.
-    xs_.resize(cloud.size());
-    ys_.resize(cloud.size());
-    zs_.resize(cloud.size());
-    for (size_t i = 0; i < cloud.size(); ++i) {
-      xs_[i] = cloud.xyz[i].x();
-      ys_[i] = cloud.xyz[i].y();
-      zs_[i] = cloud.xyz[i].z();
-    }
   }
 
   // The score of pixel (u, v), or -1 where it is not scored (no return,
@@ -182,10 +172,12 @@ class OrganizedScorer {
     thread_local std::vector<float> fx, fy, fz, dz;
     const float reach2 = 2.25f * radius2_;  // 1.5 r_s: room for p's own noise
     // CutByBorder() has kept the whole disc inside the image.
-    const size_t at = static_cast<size_t>(v) * cloud_.width + u;
-    const float* xs = xs_.data() + at;
-    const float* ys = ys_.data() + at;
-    const float* zs = zs_.data() + at;
+    // Read in place (Eigen::Vector3f is three packed floats): a copy as
+    // three planes gained nothing, the gather being scalar loads either way,
+    // and cost a first touch of 12 bytes a pixel, which on a VM's page
+    // faults was a third of a cold frame's edge stage.
+    static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
+    const Eigen::Vector3f* at = cloud_.xyz.data() + static_cast<size_t>(v) * cloud_.width + u;
     // Clamped before the cast: r fx / z is unbounded for a point near z = 0.
     const float quarter_px = radius_px * 4.0f + 0.5f;
     const int bucket = quarter_px < kMaxBucket ? static_cast<int>(quarter_px) : kMaxBucket;
@@ -199,7 +191,7 @@ class OrganizedScorer {
     const float px = p.x(), py = p.y(), pz = p.z();
     size_t m = 0;
     for (const int off : offsets) {
-      const float x = xs[off], y = ys[off], z = zs[off];
+      const float x = at[off].x(), y = at[off].y(), z = at[off].z();
       const float dx = x - px, dy = y - py, dzp = z - pz;
       fx[m] = x;
       fy[m] = y;
@@ -285,7 +277,6 @@ class OrganizedScorer {
   // Radii above kMaxBucket / 4 pixels (points nearer than ~0.17 m for the
   // default radius and a VGA camera) use the largest table.
   OffsetTables offsets_;
-  std::vector<float> xs_, ys_, zs_;
 };
 
 EdgePoints Merge(const PointCloud& cloud, std::vector<Chunk>& chunks) {
