@@ -207,14 +207,21 @@ PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOpt
       valid[i] = 1;
     }
   }
-  // Integral images of the point moments: 1, x, y, z, xx, xy, xz, yy, yz, zz.
+  // Integral images of the point moments: 1, x, y, z, xx, xy, xz, yy, yz, zz,
+  // row by row: a window needs only the rows r above and r + 1 below its
+  // centre, so the last 2r + 2 rows are kept in a ring (a whole frame's
+  // integral was 1.5 MB, most of a cold frame's page faults in this stage).
   constexpr int kM = 10;
-  std::vector<double> integral(static_cast<size_t>(W + 1) * (H + 1) * kM, 0.0);
+  const int r = o.window_cells;
+  const int ring_rows = 2 * r + 2;
+  std::vector<double> ring(static_cast<size_t>(ring_rows) * (W + 1) * kM, 0.0);
   auto at = [&](int cu, int cv) {
-    return &integral[(static_cast<size_t>(cv) * (W + 1) + cu) * kM];
+    return &ring[(static_cast<size_t>(cv % ring_rows) * (W + 1) + cu) * kM];
   };
-  for (int cv = 0; cv < H; ++cv) {
+  int integral_rows = 1;  // rows [0, integral_rows) made; row 0 is all zeros
+  auto make_row = [&](int cv) {  // integral row cv + 1, from cell row cv
     double row[kM] = {};
+    std::fill_n(at(0, cv + 1), kM, 0.0);
     for (int cu = 0; cu < W; ++cu) {
       const size_t i = static_cast<size_t>(cv) * W + cu;
       if (valid[i]) {
@@ -235,13 +242,13 @@ PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOpt
       const double* up = at(cu + 1, cv);
       for (int j = 0; j < kM; ++j) dst[j] = up[j] + row[j];
     }
-  }
+  };
   // Per cell: the window's normal and curvature.
-  const int r = o.window_cells;
   const int min_window = (2 * r + 1) * (2 * r + 1) / 2;
   std::vector<Eigen::Vector3f> normal(N, Eigen::Vector3f::Zero());
   std::vector<float> curvature(N, 1.0f);
   for (int cv = r; cv < H - r; ++cv) {
+    while (integral_rows <= cv + r + 1) make_row(integral_rows++ - 1);
     for (int cu = r; cu < W - r; ++cu) {
       const size_t i = static_cast<size_t>(cv) * W + cu;
       if (!valid[i]) continue;
