@@ -28,6 +28,7 @@
 #include "absl/strings/strip.h"
 #include "common/grpc_security/tls.h"
 #include "common/logging/log.h"
+#include "common/process/frame_memory.h"
 #include "server/config/server_config.h"
 #include "server/config/server_options.h"
 #include "server/server.h"
@@ -147,6 +148,7 @@ bool SpecifiedOnCommandLine(int argc, char** argv, absl::string_view name) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  cornerpose::KeepFrameMemoryInProcess();
   absl::SetProgramUsageMessage("Serves cornerpose.v1.PerceptionService over gRPC.");
   const std::vector<std::string> source_flags = AllSourceFlags(argc, argv);
   absl::ParseCommandLine(argc, argv);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/process/frame_memory.h"
 #include "tools/client_command.h"
 #include "tools/detect_command.h"
 
@@ -25,6 +26,7 @@ constexpr char kUsage[] =
 }  // namespace
 
 int main(int argc, char** argv) {
+  cornerpose::KeepFrameMemoryInProcess();
   if (argc < 2) {
     std::fputs(kUsage, stderr);
     return 2;
