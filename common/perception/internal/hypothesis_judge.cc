@@ -14,6 +14,48 @@ constexpr char kMovedTooFar[] = "refinement moved it too far: not this box";
 
 }  // namespace
 
+std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, BoxFace grasp,
+                              const AcceptanceOptions& o) {
+  // The in-plane position must be measured, not guessed: a free side along
+  // each of the face's axes.
+  const int fi = static_cast<int>(grasp);
+  const int axis_a = (fi / 2 + 1) % 3, axis_b = (fi / 2 + 2) % 3;
+  for (const auto& [extent, axis] :
+       {std::pair{ref.extent_a_m, axis_a}, std::pair{ref.extent_b_m, axis_b}}) {
+    if (extent > 0.0 && std::abs(extent - dims[axis]) > o.extent_tolerance_m) {
+      return absl::StrFormat("face measures %.3f m where the box is %.3f m", extent, dims[axis]);
+    }
+  }
+  // Every side that can be seen must end the face: a free border or a seam
+  // to a touching box. A face that runs on flat is a bigger face.
+  int measured = 0;
+  for (SideKind k : ref.sides) {
+    if (k == SideKind::kContinues) {
+      return "a side runs on flat with no seam (a bigger face, or a layer that does not "
+             "tile uniquely)";
+    }
+    measured += k == SideKind::kFree || k == SideKind::kSeam || k == SideKind::kTiled;
+  }
+  // At least two sides pin the face down; a face with no free side must be
+  // boxed in on all four (by seams or whole tiles of its layer).
+  if (measured < 2) return "fewer than two sides of the face measured";
+  if (ref.free_sides < 1 && measured < 4) return "no free side and not boxed in by seams on all four";
+  // A side hidden under something may hide more face: keep the box only if
+  // no bigger side of the box could stand in for this one there.
+  for (int s = 0; s < 4; ++s) {
+    if (ref.sides[s] != SideKind::kOccluded) continue;
+    const int here = s < 2 ? axis_a : axis_b, other = s < 2 ? axis_b : axis_a;
+    for (int k = 0; k < 3; ++k) {
+      if ((k != here && k != other && dims[k] > dims[here] + o.extent_tolerance_m) ||
+          (k == other && dims[k] > dims[here] + o.extent_tolerance_m &&
+           ref.sides[s < 2 ? 2 : 0] == SideKind::kOccluded)) {
+        return "a hidden side could be a longer side of the box";
+      }
+    }
+  }
+  return "";
+}
+
 double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
                     BoxFace grasp, const AcceptanceOptions& o, std::string* reason) {
   auto reject = [&](std::string why) {
@@ -48,46 +90,8 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
     return reject(absl::StrFormat("%.0f%% of the box hidden: sunk into a surface?",
                                   100.0 * ev.total.occluded / ev.total.expected));
   }
-  // The in-plane position must be measured, not guessed: a free side along
-  // each of the face's axes.
-  const int fi = static_cast<int>(grasp);
-  const int axis_a = (fi / 2 + 1) % 3, axis_b = (fi / 2 + 2) % 3;
-  for (const auto& [extent, axis] :
-       {std::pair{ref.extent_a_m, axis_a}, std::pair{ref.extent_b_m, axis_b}}) {
-    if (extent > 0.0 && std::abs(extent - dims[axis]) > o.extent_tolerance_m) {
-      return reject(
-          absl::StrFormat("face measures %.3f m where the box is %.3f m", extent, dims[axis]));
-    }
-  }
-  // Every side that can be seen must end the face: a free border or a seam
-  // to a touching box. A face that runs on flat is a bigger face.
-  int measured = 0;
-  for (SideKind k : ref.sides) {
-    if (k == SideKind::kContinues) {
-      return reject(
-          "a side runs on flat with no seam (a bigger face, or a layer that does not "
-          "tile uniquely)");
-    }
-    measured += k == SideKind::kFree || k == SideKind::kSeam || k == SideKind::kTiled;
-  }
-  // At least two sides pin the face down; a face with no free side must be
-  // boxed in on all four (by seams or whole tiles of its layer).
-  if (measured < 2) return reject("fewer than two sides of the face measured");
-  if (ref.free_sides < 1 && measured < 4) {
-    return reject("no free side and not boxed in by seams on all four");
-  }
-  // A side hidden under something may hide more face: keep the box only if
-  // no bigger side of the box could stand in for this one there.
-  for (int s = 0; s < 4; ++s) {
-    if (ref.sides[s] != SideKind::kOccluded) continue;
-    const int here = s < 2 ? axis_a : axis_b, other = s < 2 ? axis_b : axis_a;
-    for (int k = 0; k < 3; ++k) {
-      if ((k != here && k != other && dims[k] > dims[here] + o.extent_tolerance_m) ||
-          (k == other && dims[k] > dims[here] + o.extent_tolerance_m &&
-           ref.sides[s < 2 ? 2 : 0] == SideKind::kOccluded)) {
-        return reject("a hidden side could be a longer side of the box");
-      }
-    }
+  if (std::string why = RefinementVerdict(ref, dims, grasp, o); !why.empty()) {
+    return reject(std::move(why));
   }
   return std::clamp(0.5 * grasp_support + 0.5 * ev.support() - 2.0 * ev.see_through_fraction() -
                         0.25 * grasp_occluded,
@@ -195,6 +199,14 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   // full evidence would only confirm what JudgeRefined rejects it for.
   if (!cand.refinement.ok) {
     *reason = kMovedTooFar;
+    return false;
+  }
+  // What the refinement alone rejects (most often a side that runs on flat:
+  // two thirds of all refined hypotheses) needs no full evidence.
+  if (std::string why = RefinementVerdict(cand.refinement, options_.box, grasp,
+                                          options_.acceptance);
+      !why.empty()) {
+    *reason = std::move(why);
     return false;
   }
   cand.evidence = MeasureBox(depth_, cand.box.camera_T_box, options_.box, options_.evidence);

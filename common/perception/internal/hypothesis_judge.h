@@ -22,6 +22,11 @@ struct Candidate {
   RefinementResult refinement;
 };
 
+// The part of the acceptance test the refinement alone decides (the face's
+// measured extents and how its sides end): "" when it passes, else why not.
+std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, BoxFace grasp,
+                              const AcceptanceOptions& o);
+
 // The acceptance test of a refined hypothesis: its score in [0, 1], or < 0
 // when the depth image contradicts it (see AcceptanceOptions); then
 // `reason`, when given, says which test failed.
