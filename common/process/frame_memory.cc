@@ -5,6 +5,7 @@
 namespace cornerpose {
 
 bool KeepFrameMemoryInProcess(int mmap_threshold_bytes, int keep_bytes) {
+  if (mmap_threshold_bytes <= 0 || keep_bytes <= 0) return false;  // glibc takes -1 as "never"
   // mallopt returns 1 on success. Setting either turns off glibc's dynamic
   // threshold, which only rises after the first large block is freed.
   const bool mmap_ok = mallopt(M_MMAP_THRESHOLD, mmap_threshold_bytes) == 1;

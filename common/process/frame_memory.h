@@ -9,7 +9,8 @@ namespace cornerpose {
 // ~10 us a page on a VM. This keeps blocks up to `mmap_threshold_bytes` in
 // the heap and freed heap memory up to `keep_bytes` in the process, so a
 // frame reuses what the last one (or the file reader) touched. Call once,
-// first thing in main(). Returns false when the allocator refused.
+// first thing in main(). Returns false, changing nothing, when a size is
+// not positive, and false when the allocator refused.
 bool KeepFrameMemoryInProcess(int mmap_threshold_bytes = 256 << 20,
                               int keep_bytes = 256 << 20);
 
