@@ -237,10 +237,10 @@ int main(int argc, char** argv) {
   auto server = cornerpose::server::StartServer(options);
   if (!server.ok()) return fail(server.status());
   // "listening on A (port N)": what scripts and tests look for in either format.
-  logging::Log(logging::LogLevel::kInfo, "server",
-               absl::StrCat("listening on ", options.listen_address, " (port ", (*server)->port(),
-                            ")"),
-               {{"address", options.listen_address}, {"port", (*server)->port()}});
+  logging::Log(
+      logging::LogLevel::kInfo, "server",
+      absl::StrCat("listening on ", options.listen_address, " (port ", (*server)->port(), ")"),
+      {{"address", options.listen_address}, {"port", (*server)->port()}});
   if ((*server)->http_port() != 0) {
     logging::Log(logging::LogLevel::kInfo, "server",
                  absl::StrCat("http listening on ", options.http.listen_address, " (port ",
@@ -251,18 +251,17 @@ int main(int argc, char** argv) {
     logging::Log(logging::LogLevel::kInfo, "server", "source",
                  {{"name", spec.name},
                   {"where", spec.kind == cornerpose::server::SourceKind::kDirectory ? spec.directory
-                                                                                  : spec.uri}});
+                                                                                    : spec.uri}});
   }
   // A line of its own: scripts and tests match the one above.
-  logging::Log(logging::LogLevel::kInfo, "server",
-               absl::StrCat(options.tls_client_ca.empty()
-                                ? (options.tls_cert.empty() ? "plaintext" : "TLS")
-                                : "mutual TLS",
-                            options.enable_reflection ? ", reflection on" : ", reflection off"),
-               {{"tls", options.tls_client_ca.empty()
-                            ? (options.tls_cert.empty() ? "plaintext" : "tls")
-                            : "mutual_tls"},
-                {"reflection", options.enable_reflection}});
+  logging::Log(
+      logging::LogLevel::kInfo, "server",
+      absl::StrCat(options.tls_client_ca.empty() ? (options.tls_cert.empty() ? "plaintext" : "TLS")
+                                                 : "mutual TLS",
+                   options.enable_reflection ? ", reflection on" : ", reflection off"),
+      {{"tls", options.tls_client_ca.empty() ? (options.tls_cert.empty() ? "plaintext" : "tls")
+                                             : "mutual_tls"},
+       {"reflection", options.enable_reflection}});
   if (const std::string warning = cornerpose::PlaintextWarning(
           "cornerpose_server", options.listen_address, !options.tls_cert.empty());
       !warning.empty()) {

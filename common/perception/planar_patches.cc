@@ -218,7 +218,7 @@ PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOpt
   auto at = [&](int cu, int cv) {
     return &ring[(static_cast<size_t>(cv % ring_rows) * (W + 1) + cu) * kM];
   };
-  int integral_rows = 1;  // rows [0, integral_rows) made; row 0 is all zeros
+  int integral_rows = 1;         // rows [0, integral_rows) made; row 0 is all zeros
   auto make_row = [&](int cv) {  // integral row cv + 1, from cell row cv
     double row[kM] = {};
     std::fill_n(at(0, cv + 1), kM, 0.0);

@@ -11,7 +11,6 @@ namespace cornerpose {
 // frame reuses what the last one (or the file reader) touched. Call once,
 // first thing in main(). Returns false, changing nothing, when a size is
 // not positive, and false when the allocator refused.
-bool KeepFrameMemoryInProcess(int mmap_threshold_bytes = 256 << 20,
-                              int keep_bytes = 256 << 20);
+bool KeepFrameMemoryInProcess(int mmap_threshold_bytes = 256 << 20, int keep_bytes = 256 << 20);
 
 }  // namespace cornerpose

@@ -39,7 +39,9 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
   // At least two sides pin the face down; a face with no free side must be
   // boxed in on all four (by seams or whole tiles of its layer).
   if (measured < 2) return "fewer than two sides of the face measured";
-  if (ref.free_sides < 1 && measured < 4) return "no free side and not boxed in by seams on all four";
+  if (ref.free_sides < 1 && measured < 4) {
+    return "no free side and not boxed in by seams on all four";
+  }
   // A side hidden under something may hide more face: keep the box only if
   // no bigger side of the box could stand in for this one there.
   for (int s = 0; s < 4; ++s) {
@@ -203,8 +205,8 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   }
   // What the refinement alone rejects (most often a side that runs on flat:
   // two thirds of all refined hypotheses) needs no full evidence.
-  if (std::string why = RefinementVerdict(cand.refinement, options_.box, grasp,
-                                          options_.acceptance);
+  if (std::string why =
+          RefinementVerdict(cand.refinement, options_.box, grasp, options_.acceptance);
       !why.empty()) {
     *reason = std::move(why);
     return false;
