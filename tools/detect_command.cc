@@ -81,6 +81,11 @@ constexpr char kHelp[] =
     "  --side_allowance M   on a box's faces but the one it shows most, depth up to M\n"
     "                       behind the tolerance is no evidence either way (time-of-\n"
     "                       flight multipath in concave creases; 0.025; 0: off)\n"
+    "  --rim_sides BOOL     a side where the face runs on but ends within 2 cm is free\n"
+    "                       there, when it is the face's only side in doubt (true)\n"
+    "  --anchored_faces BOOL a planar patch that does not tile (an L of box tops, a\n"
+    "                       layer cut by the border) proposes a face in each of its\n"
+    "                       corners (false)\n"
     "  --border_faces BOOL  a planar patch at the image border no bigger than a face\n"
     "                       proposes that face (true)\n"
     "  --retry_declined BOOL a pose refined and declined is judged once more when\n"
@@ -130,6 +135,8 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides),
         args.SetInt("max_declined", &options.max_declined),
         args.SetBool("border_faces", &options.faces.propose_at_border),
+        args.SetBool("anchored_faces", &options.faces.anchored.enabled),
+        args.SetBool("rim_sides", &options.refinement.rim_ends_side),
         args.SetBool("retry_declined", &options.retry_declined),
         args.SetInt("patch_window", &options.faces.patches.window_cells),
         args.SetDouble("side_allowance", &options.evidence.side_face_allowance_m)}) {
@@ -231,6 +238,8 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "max_declined",
                                                        "side_allowance",
                                                        "border_faces",
+                                                       "anchored_faces",
+                                                       "rim_sides",
                                                        "retry_declined",
                                                        "patch_window"},
                                                       {"quiet", "kdtree"});

@@ -65,32 +65,45 @@ struct FacePoints {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
   std::array<std::vector<FacePoint>, 4> on_plane, front, grid;  // +a, -a, +b, -b bands
+  // Per side, the points on the plane (within twice its tolerance) one band
+  // further out (margin to twice it past the side, clear of the corners):
+  // whether a face that runs past the side goes on, or ends within the band.
+  std::array<int, 4> further{};
 };
 
 // Side order +a, -a, +b, -b, as RefinementResult::sides.
 int SideIndex(bool along_a, double sign) { return (along_a ? 0 : 2) + (sign > 0.0 ? 0 : 1); }
 
 // Fills *out (its vectors cleared first: a caller that keeps it keeps their
-// capacity, and a refinement then allocates nothing).
+// capacity, and a refinement then allocates nothing); `further` too when
+// count_further (a band more of the image is read for it).
 void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margin, double plane_tol,
-                       FacePoints* out_points) {
+                       bool count_further, FacePoints* out_points) {
   FacePoints& out = *out_points;
   out.interior = 0;
   out.sum.setZero();
   out.sum_outer.setZero();
+  out.further = {};
   for (auto* lists : {&out.on_plane, &out.front, &out.grid}) {
     for (std::vector<FacePoint>& l : *lists) l.clear();
   }
   const CameraIntrinsics& k = depth.camera;
-  std::vector<Eigen::Vector3d> outline;
-  for (double sa : {-1.0, 1.0}) {
-    for (double sb : {-1.0, 1.0}) {
-      outline.push_back(f.c + sa * (f.half_a + margin) * f.a + sb * (f.half_b + margin) * f.b);
+  // The image of the face and its bands (`near`: every list is filled from
+  // it), and of one band more (`rect`: only the counts further out).
+  auto outline_rect = [&](double m) {
+    std::vector<Eigen::Vector3d> outline;
+    for (double sa : {-1.0, 1.0}) {
+      for (double sb : {-1.0, 1.0}) {
+        outline.push_back(f.c + sa * (f.half_a + m) * f.a + sb * (f.half_b + m) * f.b);
+      }
     }
-  }
-  const std::optional<PixelRect> rect = ProjectedRect(k, outline);
-  if (!rect) return;
-  const int ua = rect->u0, ub = rect->u1, va = rect->v0, vb = rect->v1;
+    return ProjectedRect(k, outline);
+  };
+  const std::optional<PixelRect> near = outline_rect(margin);
+  if (!near) return;
+  const PixelRect rect =
+      count_further ? outline_rect(2.0 * margin).value_or(*near) : *near;
+  const int ua = rect.u0, ub = rect.u1, va = rect.v0, vb = rect.v1;
   // The bands' inner edges, a hair inside so that each reader's own test
   // (which may round the other way) sees every point it would have seen.
   const double band_a = f.half_a - margin - 1e-9, band_b = f.half_b - margin - 1e-9;
@@ -116,6 +129,18 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
   }
   const double lim_a = f.half_a + margin, lim_b = f.half_b + margin;
   const double in_a = f.half_a - margin, in_b = f.half_b - margin;
+  const double far_a = f.half_a + 2.0 * margin, far_b = f.half_b + 2.0 * margin;
+  // A point a band past a side, clear of the corners, on the plane within
+  // twice its tolerance (a plane fitted to a small, noisy face may be off by
+  // degrees, which a band further out magnifies).
+  auto add_further = [&](const FacePoint& q) {
+    if (std::abs(q.n) > 2.0 * plane_tol) return;
+    if (std::abs(q.b) <= in_b && std::abs(q.a) > lim_a && std::abs(q.a) <= far_a) {
+      ++out.further[q.a > 0.0 ? 0 : 1];
+    } else if (std::abs(q.a) <= in_a && std::abs(q.b) > lim_b && std::abs(q.b) <= far_b) {
+      ++out.further[q.b > 0.0 ? 2 : 3];
+    }
+  };
   // The grid is kept only near the sides: pixels well inside the image of
   // the inner rectangle (a pixel to spare) need no ray-plane intersection.
   std::array<Eigen::Vector2d, 4> inner;
@@ -137,9 +162,14 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
       skip1 -= 1.0;
     }
     double sa = 0, sb = 0, sn = 0, saa = 0, sab = 0, san = 0, sbb = 0, sbn = 0, snn = 0;
+    const bool row_near = v >= near->v0 && v <= near->v1;
     for (int u = ua; u <= ub; ++u) {
       const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row, n_r = n_x[u - ua] + n_row;
       const float z = zrow[u];
+      if (!row_near || u < near->u0 || u > near->u1) {
+        if (!std::isnan(z)) add_further(FacePoint{z * a_r - a_c, z * b_r - b_c, z * n_r - n_c});
+        continue;
+      }
       if ((u <= skip0 || u >= skip1) && std::abs(n_r) > 1e-6) {
         const double t = n_c / n_r;
         const double qa = t * a_r - a_c, qb = t * b_r - b_c;
@@ -151,7 +181,10 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
       }
       if (std::isnan(z)) continue;
       const FacePoint q{z * a_r - a_c, z * b_r - b_c, z * n_r - n_c};
-      if (std::abs(q.a) > lim_a || std::abs(q.b) > lim_b) continue;
+      if (std::abs(q.a) > lim_a || std::abs(q.b) > lim_b) {
+        if (count_further) add_further(q);
+        continue;
+      }
       if (q.n > plane_tol) {
         to_sides(q, out.front);
         continue;
@@ -181,6 +214,11 @@ struct SideMeasure {
   SideKind kind = SideKind::kUnknown;
   double position = 0.0;  // along the side's normal axis, face coordinates
   double slope = 0.0;     // d(position)/d(along), turn of the side (free sides)
+  // The points on the plane a band further out, over those just inside.
+  double further_share = 0.0;
+  // kContinues only: the plane ends within the band past the side, here.
+  bool rim = false;
+  double rim_position = 0.0, rim_slope = 0.0;
   bool measured() const { return kind == SideKind::kFree || kind == SideKind::kSeam; }
 };
 
@@ -474,6 +512,7 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
   }
   SideMeasure m;
   if (inner < 10) return m;  // hidden or cut: no say
+  m.further_share = static_cast<double>(face.further[side]) / inner;
   // Something in front of the plane just past the side: the face may go on
   // underneath it, so the side is not where the face ends.
   int in_front = 0;
@@ -487,6 +526,28 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
     m.kind = SideKind::kOccluded;
     return m;
   }
+  // Outermost point per bin, then a robust line through them: where the
+  // face ends (false when too few bins have a point).
+  auto measure_end = [&](SideMeasure* out) {
+    std::vector<std::pair<double, double>> ends;  // (along, across)
+    for (int k = 0; k < nbins; ++k) {
+      if (best[k] > -1.0) ends.emplace_back(-half_other + band + (k + 0.5) * bin, best[k]);
+    }
+    if (static_cast<int>(ends.size()) < std::max(3, nbins / 3)) return false;
+    std::vector<double> across;
+    for (auto& e : ends) across.push_back(e.second);
+    out->position = Median(across);
+    // Slope by the median of pairwise slopes (Theil-Sen) over bins far apart.
+    std::vector<double> slopes;
+    for (size_t i = 0; i < ends.size(); ++i) {
+      for (size_t j = i + 1; j < ends.size(); ++j) {
+        const double dl = ends[j].first - ends[i].first;
+        if (dl > 0.03) slopes.push_back((ends[j].second - ends[i].second) / dl);
+      }
+    }
+    out->slope = slopes.empty() ? 0.0 : Median(slopes);
+    return true;
+  };
   if (outer > o.free_side_ratio * inner) {
     // The face continues past the side: a seam to a touching box, or the
     // hypothesis is too small for this face.
@@ -496,29 +557,63 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
       m.position = *seam;
     } else {
       m.kind = SideKind::kContinues;
+      // ... or only its rim does: the plane ends within the band (nothing
+      // of it a band further out), where a free side may be (RimAsFree).
+      if (o.rim_ends_side && m.further_share <= o.free_side_ratio) {
+        SideMeasure end;
+        if (measure_end(&end)) {
+          m.rim_position = end.position;
+          m.rim_slope = end.slope;
+          m.rim = true;
+        }
+      }
     }
     return m;
   }
-  // Outermost point per bin, then a robust line through them.
-  std::vector<std::pair<double, double>> ends;  // (along, across)
-  for (int k = 0; k < nbins; ++k) {
-    if (best[k] > -1.0) ends.emplace_back(-half_other + band + (k + 0.5) * bin, best[k]);
-  }
-  if (static_cast<int>(ends.size()) < std::max(3, nbins / 3)) return m;
-  std::vector<double> across;
-  for (auto& e : ends) across.push_back(e.second);
-  m.position = Median(across);
-  // Slope by the median of pairwise slopes (Theil-Sen) over bins far apart.
-  std::vector<double> slopes;
-  for (size_t i = 0; i < ends.size(); ++i) {
-    for (size_t j = i + 1; j < ends.size(); ++j) {
-      const double dl = ends[j].first - ends[i].first;
-      if (dl > 0.03) slopes.push_back((ends[j].second - ends[i].second) / dl);
-    }
-  }
-  m.slope = slopes.empty() ? 0.0 : Median(slopes);
+  if (!measure_end(&m)) return m;
   m.kind = SideKind::kFree;
   return m;
+}
+
+// A face whose rim spreads past one side (a bulging carton; an active stereo
+// camera's fattened edges and smoothing; noise at a crease seen obliquely)
+// runs on past that side by a centimetre or so and then ends: the side is
+// free where the face ends, when that is the only side in doubt: its
+// opposite side free, and every side of the face measured (a side hidden or
+// cut would leave the face's true size open).
+void RimAsFree(std::array<SideMeasure*, 4> sides, double half_a, double half_b,
+               const RefinementOptions& o) {
+  int rims = 0, unknown = 0, rim = -1;
+  for (int i = 0; i < 4; ++i) {
+    if (sides[i]->kind == SideKind::kContinues && sides[i]->rim) {
+      ++rims;
+      rim = i;
+    }
+    unknown += sides[i]->kind == SideKind::kUnknown || sides[i]->kind == SideKind::kOccluded;
+  }
+  if (rims != 1 || unknown > 0) return;
+  // The opposite side must end the face for good: no plane resuming past
+  // it (a strip of missing returns across a face, as dark tape leaves on a
+  // stereo camera, ends half of it at a free side).
+  const SideMeasure& opposite = *sides[rim ^ 1];
+  if (opposite.kind != SideKind::kFree || opposite.further_share > o.free_side_ratio) return;
+  // The face so measured is the box's size on both axes: across the rim
+  // from rim_extent_tolerance_m short to twice it long (the rim adds to
+  // it), along it within the tolerance when both its sides are free (a face
+  // a rim too big is also what a box of another size shows).
+  SideMeasure& m = *sides[rim];
+  const double half = rim < 2 ? half_a : half_b, other_half = rim < 2 ? half_b : half_a;
+  const SideMeasure& o1 = *sides[rim < 2 ? 2 : 0];
+  const SideMeasure& o2 = *sides[rim < 2 ? 3 : 1];
+  const double over = m.rim_position + opposite.position - 2.0 * half;
+  if (over < -o.rim_extent_tolerance_m || over > 2.0 * o.rim_extent_tolerance_m ||
+      (o1.kind == SideKind::kFree && o2.kind == SideKind::kFree &&
+       std::abs(o1.position + o2.position - 2.0 * other_half) > o.rim_extent_tolerance_m)) {
+    return;
+  }
+  m.kind = SideKind::kFree;
+  m.position = m.rim_position;
+  m.slope = m.rim_slope;
 }
 
 // The image line along a side at `position` (face coordinates along the
@@ -695,6 +790,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.tile_gap_m", tile_gap_m, 0.0, 0.2),
            CheckRange("refinement.tile_tolerance_m", tile_tolerance_m, 0.0, 0.2),
            CheckRange("refinement.max_tile_march_m", max_tile_march_m, 0.0, 100.0),
+           CheckRange("refinement.rim_extent_tolerance_m", rim_extent_tolerance_m, 0.0, 0.1),
            CheckRange("refinement.iterations", iterations, 0, 20),
            CheckPositive("refinement.max_shift_m", max_shift_m),
            CheckPositive("refinement.max_turn_deg", max_turn_deg),
@@ -714,7 +810,8 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
                 RefinementResult& result) {
   FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
   thread_local FacePoints face;  // reused: its vectors keep their capacity
-  CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m, &face);
+  CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m,
+                    options.rim_ends_side, &face);
   const double pixel_m = f.c.z() / depth.camera.fx;  // point spacing on the face
   // Plane through the interior points: their scatter about the mean is
   // sum(q q^T) - n mean mean^T (face coordinates are centimetres to a
@@ -752,6 +849,7 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
     ColourSeamSide(depth, f, false, 1.0, options, &pb);
     ColourSeamSide(depth, f, false, -1.0, options, &mb);
   }
+  if (options.rim_ends_side) RimAsFree({&pa, &ma, &pb, &mb}, f.half_a, f.half_b, options);
   result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
   result.free_sides = 0;
   for (SideKind k : result.sides) result.free_sides += k == SideKind::kFree;

@@ -73,6 +73,17 @@ struct RefinementOptions {
   // stereo camera's noise leaves grooves inside a face; two boxes that
   // touch leave a line in the image). 0 trusts the depth alone. Unitless.
   double colour_confirms_seam = 0.5;
+  // A side where the face runs on but ends within side_band_m (nothing on
+  // its plane a band further out) is free where the face ends, when it is
+  // the face's only such side, its opposite side is free and no side is
+  // hidden or cut: a carton's bulge, or an active stereo camera's fattened
+  // edges and smoothing (a brick at 1.4 m seen a centimetre long at one
+  // end). The measured extent is still checked against the box's size.
+  bool rim_ends_side = true;
+  // ... and when the face so measured is the box's size: across the rim
+  // from this short to twice this long, along it within this (where both
+  // its sides are free). Metres.
+  double rim_extent_tolerance_m = 0.015;
   // Iterations of measure-and-update. Count.
   int iterations = 2;
   // Largest correction accepted, beyond which the hypothesis is not this

@@ -68,6 +68,7 @@ Eigen::Isometry3d TilePose(const PlaneRectangle& rect, const FaceTiling& t, cons
 absl::Status FaceProposalOptions::Validate() const {
   if (absl::Status s = patches.Validate(); !s.ok()) return s;
   if (absl::Status s = seams.Validate(); !s.ok()) return s;
+  if (absl::Status s = anchored.Validate(); !s.ok()) return s;
   if (!(size_tolerance_m > 0.0 && size_tolerance_m <= 0.1) ||
       !(max_gap_m >= 0.0 && max_gap_m <= 0.05) ||
       !(max_view_angle_deg > 0.0 && max_view_angle_deg < 90.0) || max_tiles < 1 ||
@@ -199,6 +200,11 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
   std::sort(sorted.begin(), sorted.end());
   const double smallest_face = sorted[0] * sorted[1];
   const double cos_view = std::cos(o.max_view_angle_deg * std::numbers::pi / 180.0);
+  auto anchor = [&](const PlanarPatch& patch, const PlaneRectangle& rect, double cell_m) {
+    const std::vector<Eigen::Isometry3d> faces =
+        AnchoredFaces(patch, rect, cell_m, image.camera, dims, o.anchored);
+    out.poses.insert(out.poses.end(), faces.begin(), faces.end());
+  };
   for (size_t id = 0; id < patches.patches.size() && !StopRequested(cancel); ++id) {
     const PlanarPatch& patch = patches.patches[id];
     const double cell_m = patch.centroid.z() / image.camera.fx * patches.step_px;
@@ -213,8 +219,11 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     // decides whether every side was seen (AcceptanceOptions).
     const double largest_side = sorted[2] + o.size_tolerance_m;
     const bool at_border = patch.touches_border;
+    // One bigger than a face (a layer, a heap's top) still has its corners
+    // inside the view: faces anchored there.
     if (at_border &&
         (!o.propose_at_border || rect.width > largest_side || rect.height > largest_side)) {
+      if (o.propose_at_border) anchor(patch, rect, cell_m);
       continue;
     }
     // A patch filling little of its outline is no face or layer (a floor
@@ -283,7 +292,10 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
       // face in each corner of the outline, for each way one fits in it;
       // only for an outline about one face in size (a bigger one is a
       // floor, a wall, a layer cut by the image border).
-      if (rect.width > largest_side || rect.height > largest_side) continue;
+      if (rect.width > largest_side || rect.height > largest_side) {
+        anchor(patch, rect, cell_m);
+        continue;
+      }
       for (int n = 0; n < 3; ++n) {
         const int a = (n + 1) % 3, b = (n + 2) % 3;
         for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "common/perception/anchored_faces.h"
 #include "common/perception/camera_model.h"
 #include "common/perception/cancel_token.h"
 #include "common/perception/planar_patches.h"
@@ -26,6 +27,10 @@ namespace cornerpose {
 struct FaceProposalOptions {
   PlanarPatchOptions patches;
   SeamCueOptions seams;
+  // Faces anchored in the corners of a patch that does not tile (an L of
+  // box tops, a layer with a box of another size, a layer cut by the image
+  // border); anchored_faces.h.
+  AnchoredFaceOptions anchored;
   // A run of n faces fits an outline side when it is n sizes plus 0 to
   // (n - 1) max_gap_m long, within size_tolerance_m. Metres.
   double size_tolerance_m = 0.02;

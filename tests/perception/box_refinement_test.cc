@@ -294,5 +294,44 @@ TEST(RefineOnGraspFaceTest, ASideUnderABoxStandingOnTheFaceIsNotFree) {
   }
 }
 
+// A carton a centimetre long (a bulge, or an active stereo camera's
+// fattened edges), read flush with its -x end: the +x side runs on by
+// 12 mm and then ends. It is free where the face ends (the face's only side
+// in doubt, its opposite free), and the box is centred on the measured face.
+TEST(RefineOnGraspFaceTest, AFaceARimTooLongEndsWhereItsPointsEnd) {
+  const BoxDims bulging{kCartonS.l + 0.012, kCartonS.b, kCartonS.h};
+  const FlatScene s = RenderFlat({Flat(bulging, 0.0, 0.0)});
+  const GroundTruthBox& gt = s.rendered.boxes[0];
+  const Eigen::Isometry3d flush = Moved(gt.camera_T_box, -0.006, 0.0, 0.0);
+  Eigen::Isometry3d pose = flush;
+  const RefinementResult r =
+      RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), RefinementOptions{}, &pose);
+  ASSERT_TRUE(r.ok);
+  for (SideKind k : r.sides) EXPECT_EQ(k, SideKind::kFree);
+  EXPECT_NEAR(r.extent_a_m, bulging.l, 0.008);
+  EXPECT_LT(ComparePoses(pose, gt.camera_T_box, bulging).translation_m, 0.004);
+  // The rule off: the side runs on, as a bigger face's would.
+  RefinementOptions off;
+  off.rim_ends_side = false;
+  pose = flush;
+  const RefinementResult r_off = RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), off, &pose);
+  EXPECT_EQ(r_off.sides[0], SideKind::kContinues);
+}
+
+// The rim rule does not make a box of another size this one: a face whose
+// other axis is 3 cm short of the box, or that runs on 4 cm (past the band a
+// side is read in), keeps a side that runs on.
+TEST(RefineOnGraspFaceTest, ARimDoesNotMakeAnotherSizeTheBox) {
+  for (const BoxDims& other : {BoxDims{kCartonS.l + 0.012, kCartonS.b - 0.03, kCartonS.h},
+                               BoxDims{kCartonS.l + 0.04, kCartonS.b, kCartonS.h}}) {
+    const FlatScene s = RenderFlat({Flat(other, 0.0, 0.0)});
+    const GroundTruthBox& gt = s.rendered.boxes[0];
+    Eigen::Isometry3d pose = Moved(gt.camera_T_box, -(other.l - kCartonS.l) / 2.0, 0.0, 0.0);
+    const RefinementResult r =
+        RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), RefinementOptions{}, &pose);
+    EXPECT_NE(r.sides[0], SideKind::kFree) << other.l << " x " << other.b;
+  }
+}
+
 }  // namespace
 }  // namespace cornerpose::testing
