@@ -216,6 +216,9 @@ struct SideMeasure {
   double slope = 0.0;     // d(position)/d(along), turn of the side (free sides)
   // The points on the plane a band further out, over those just inside.
   double further_share = 0.0;
+  // kSeam only: found past the symmetric search window, in its outward
+  // extension (see OutwardSeamsNeedEverySide).
+  bool outward_seam = false;
   // kContinues only: the plane ends within the band past the side, here.
   bool rim = false;
   double rim_position = 0.0, rim_slope = 0.0;
@@ -461,7 +464,11 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
   if (whole.points() < 50 || whole.expected() < 50) return std::nullopt;
   std::optional<double> best;
   double best_strength = 0.0;
-  for (double c = -o.seam_search_m; c <= o.seam_search_m + 1e-9; c += 0.001) {
+  // Further out than in: a face placed by a free side that reads long (a
+  // stereo camera's fattened edge, a bulge) puts the seam side short of
+  // the seam (RefinementOptions::seam_search_outward_m).
+  const double lo = -o.seam_search_m, hi = o.seam_search_m + o.seam_search_outward_m;
+  for (double c = lo; c <= hi + 1e-9; c += 0.001) {
     const std::optional<double> strength = whole.Strength(c);
     if (strength && *strength > 0.0 && *strength > best_strength) {
       best_strength = *strength;
@@ -470,7 +477,7 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
   }
   // A dip at the end of the search range is the flank of something
   // further away, not a seam here.
-  if (!best || std::abs(*best) > o.seam_search_m - 0.0015) return std::nullopt;
+  if (!best || *best < lo + 0.0015 || *best > hi - 0.0015) return std::nullopt;
   // A seam runs the whole side: each half of it shows one near the same
   // offset (within a millimetre), if only a weak one. A cluster of missing
   // returns in one place (Kinect speckle) makes a dip in the whole side's
@@ -555,6 +562,7 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
             FindSeam(pts, grid, along_a, sign, half, half_other, pixel_m, o)) {
       m.kind = SideKind::kSeam;
       m.position = *seam;
+      m.outward_seam = *seam - half > o.seam_search_m - 0.0015;
     } else {
       m.kind = SideKind::kContinues;
       // ... or only its rim does: the plane ends within the band (nothing
@@ -573,6 +581,20 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
   if (!measure_end(&m)) return m;
   m.kind = SideKind::kFree;
   return m;
+}
+
+// A seam found only in the outward extension of the search is kept when
+// every side of the face is measured (none hidden or cut): a face pinned
+// by such a seam and a side out of sight was, on the generated pallets, a
+// box's end face carved out of a longer top by Kinect noise.
+void OutwardSeamsNeedEverySide(std::array<SideMeasure*, 4> sides) {
+  const bool all_seen = std::none_of(sides.begin(), sides.end(), [](const SideMeasure* m) {
+    return m->kind == SideKind::kUnknown || m->kind == SideKind::kOccluded;
+  });
+  if (all_seen) return;
+  for (SideMeasure* m : sides) {
+    if (m->kind == SideKind::kSeam && m->outward_seam) m->kind = SideKind::kContinues;
+  }
 }
 
 // A face whose rim spreads past one side (a bulging carton; an active stereo
@@ -785,6 +807,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.sparse_seam_missing", sparse_seam_missing, 0.0, 1.0),
            CheckRange("refinement.sparse_seam_sigma", sparse_seam_sigma, 0.0, 100.0),
            CheckRange("refinement.seam_search_m", seam_search_m, 0.0, 0.2),
+           CheckRange("refinement.seam_search_outward_m", seam_search_outward_m, 0.0, 0.2),
            CheckRange("refinement.colour_confirms_seam", colour_confirms_seam, 0.0, 1.0),
            CheckRange("refinement.seam_halves_min_strength", seam_halves_min_strength, -10.0, 1.0),
            CheckRange("refinement.tile_gap_m", tile_gap_m, 0.0, 0.2),
@@ -849,6 +872,7 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
     ColourSeamSide(depth, f, false, 1.0, options, &pb);
     ColourSeamSide(depth, f, false, -1.0, options, &mb);
   }
+  OutwardSeamsNeedEverySide({&pa, &ma, &pb, &mb});
   if (options.rim_ends_side) RimAsFree({&pa, &ma, &pb, &mb}, f.half_a, f.half_b, options);
   result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
   result.free_sides = 0;

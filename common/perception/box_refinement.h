@@ -47,6 +47,11 @@ struct RefinementOptions {
   // The groove is looked for this far either side of the hypothesised side.
   // Metres.
   double seam_search_m = 0.006;
+  // ... and this much further outward: a face placed by its free side, which
+  // reads long by a fattened edge or a bulge, puts the seam side short of
+  // the seam. A seam found only there counts when no side of the face is
+  // hidden or cut. Metres.
+  double seam_search_outward_m = 0.004;
   // A seam must show in each half of the side too, with at least this
   // strength (how far past its thresholds; 0 = at them, negative = short of
   // them by that share): random clusters of missing returns make a dip in

@@ -333,5 +333,30 @@ TEST(RefineOnGraspFaceTest, ARimDoesNotMakeAnotherSizeTheBox) {
   }
 }
 
+// Two cartons end to end, 3 mm apart, the first 6 mm long (a bulge): read
+// from its free end, its seam side falls 6-9 mm short of the gap, past the
+// 6 mm either way a seam is looked for. The outward extension of the search
+// (seam_search_outward_m) finds it; without it the side runs on.
+TEST(RefineOnGraspFaceTest, ASeamPastAFaceThatReadsLongIsFoundOutward) {
+  const BoxDims bulging{kCartonS.l + 0.006, kCartonS.b, kCartonS.h};
+  const FlatScene s = RenderFlat(
+      {Flat(bulging, 0.0, 0.0), Flat(kCartonS, (bulging.l + kCartonS.l) / 2.0 + 0.003, 0.0)});
+  const GroundTruthBox& gt = s.rendered.boxes[0];
+  const Eigen::Isometry3d from_free_end = Moved(gt.camera_T_box, -0.003, 0.0, 0.0);
+  RefinementOptions no_rim;  // the seam alone, not the rim rule, is tested
+  no_rim.rim_ends_side = false;
+  Eigen::Isometry3d pose = from_free_end;
+  const RefinementResult r = RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), no_rim, &pose);
+  ASSERT_TRUE(r.ok);
+  EXPECT_EQ(r.sides[0], SideKind::kSeam);
+  EXPECT_EQ(r.sides[1], SideKind::kFree);
+  EXPECT_NEAR(r.extent_a_m, bulging.l, 0.006);
+  RefinementOptions symmetric = no_rim;
+  symmetric.seam_search_outward_m = 0.0;
+  pose = from_free_end;
+  EXPECT_EQ(RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), symmetric, &pose).sides[0],
+            SideKind::kContinues);
+}
+
 }  // namespace
 }  // namespace cornerpose::testing
