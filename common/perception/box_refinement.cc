@@ -65,45 +65,32 @@ struct FacePoints {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
   std::array<std::vector<FacePoint>, 4> on_plane, front, grid;  // +a, -a, +b, -b bands
-  // Per side, the points on the plane (within twice its tolerance) one band
-  // further out (margin to twice it past the side, clear of the corners):
-  // whether a face that runs past the side goes on, or ends within the band.
-  std::array<int, 4> further{};
 };
 
 // Side order +a, -a, +b, -b, as RefinementResult::sides.
 int SideIndex(bool along_a, double sign) { return (along_a ? 0 : 2) + (sign > 0.0 ? 0 : 1); }
 
 // Fills *out (its vectors cleared first: a caller that keeps it keeps their
-// capacity, and a refinement then allocates nothing); `further` too when
-// count_further (a band more of the image is read for it).
+// capacity, and a refinement then allocates nothing).
 void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margin, double plane_tol,
-                       bool count_further, FacePoints* out_points) {
+                       FacePoints* out_points) {
   FacePoints& out = *out_points;
   out.interior = 0;
   out.sum.setZero();
   out.sum_outer.setZero();
-  out.further = {};
   for (auto* lists : {&out.on_plane, &out.front, &out.grid}) {
     for (std::vector<FacePoint>& l : *lists) l.clear();
   }
   const CameraIntrinsics& k = depth.camera;
-  // The image of the face and its bands (`near`: every list is filled from
-  // it), and of one band more (`rect`: only the counts further out).
-  auto outline_rect = [&](double m) {
-    std::vector<Eigen::Vector3d> outline;
-    for (double sa : {-1.0, 1.0}) {
-      for (double sb : {-1.0, 1.0}) {
-        outline.push_back(f.c + sa * (f.half_a + m) * f.a + sb * (f.half_b + m) * f.b);
-      }
+  std::vector<Eigen::Vector3d> outline;
+  for (double sa : {-1.0, 1.0}) {
+    for (double sb : {-1.0, 1.0}) {
+      outline.push_back(f.c + sa * (f.half_a + margin) * f.a + sb * (f.half_b + margin) * f.b);
     }
-    return ProjectedRect(k, outline);
-  };
-  const std::optional<PixelRect> near = outline_rect(margin);
-  if (!near) return;
-  const PixelRect rect =
-      count_further ? outline_rect(2.0 * margin).value_or(*near) : *near;
-  const int ua = rect.u0, ub = rect.u1, va = rect.v0, vb = rect.v1;
+  }
+  const std::optional<PixelRect> rect = ProjectedRect(k, outline);
+  if (!rect) return;
+  const int ua = rect->u0, ub = rect->u1, va = rect->v0, vb = rect->v1;
   // The bands' inner edges, a hair inside so that each reader's own test
   // (which may round the other way) sees every point it would have seen.
   const double band_a = f.half_a - margin - 1e-9, band_b = f.half_b - margin - 1e-9;
@@ -129,18 +116,6 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
   }
   const double lim_a = f.half_a + margin, lim_b = f.half_b + margin;
   const double in_a = f.half_a - margin, in_b = f.half_b - margin;
-  const double far_a = f.half_a + 2.0 * margin, far_b = f.half_b + 2.0 * margin;
-  // A point a band past a side, clear of the corners, on the plane within
-  // twice its tolerance (a plane fitted to a small, noisy face may be off by
-  // degrees, which a band further out magnifies).
-  auto add_further = [&](const FacePoint& q) {
-    if (std::abs(q.n) > 2.0 * plane_tol) return;
-    if (std::abs(q.b) <= in_b && std::abs(q.a) > lim_a && std::abs(q.a) <= far_a) {
-      ++out.further[q.a > 0.0 ? 0 : 1];
-    } else if (std::abs(q.a) <= in_a && std::abs(q.b) > lim_b && std::abs(q.b) <= far_b) {
-      ++out.further[q.b > 0.0 ? 2 : 3];
-    }
-  };
   // The grid is kept only near the sides: pixels well inside the image of
   // the inner rectangle (a pixel to spare) need no ray-plane intersection.
   std::array<Eigen::Vector2d, 4> inner;
@@ -162,14 +137,9 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
       skip1 -= 1.0;
     }
     double sa = 0, sb = 0, sn = 0, saa = 0, sab = 0, san = 0, sbb = 0, sbn = 0, snn = 0;
-    const bool row_near = v >= near->v0 && v <= near->v1;
     for (int u = ua; u <= ub; ++u) {
       const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row, n_r = n_x[u - ua] + n_row;
       const float z = zrow[u];
-      if (!row_near || u < near->u0 || u > near->u1) {
-        if (!std::isnan(z)) add_further(FacePoint{z * a_r - a_c, z * b_r - b_c, z * n_r - n_c});
-        continue;
-      }
       if ((u <= skip0 || u >= skip1) && std::abs(n_r) > 1e-6) {
         const double t = n_c / n_r;
         const double qa = t * a_r - a_c, qb = t * b_r - b_c;
@@ -181,10 +151,7 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
       }
       if (std::isnan(z)) continue;
       const FacePoint q{z * a_r - a_c, z * b_r - b_c, z * n_r - n_c};
-      if (std::abs(q.a) > lim_a || std::abs(q.b) > lim_b) {
-        if (count_further) add_further(q);
-        continue;
-      }
+      if (std::abs(q.a) > lim_a || std::abs(q.b) > lim_b) continue;
       if (q.n > plane_tol) {
         to_sides(q, out.front);
         continue;
@@ -214,12 +181,12 @@ struct SideMeasure {
   SideKind kind = SideKind::kUnknown;
   double position = 0.0;  // along the side's normal axis, face coordinates
   double slope = 0.0;     // d(position)/d(along), turn of the side (free sides)
-  // The points on the plane a band further out, over those just inside.
-  double further_share = 0.0;
+  // The points on the plane just inside the side (the band's inner half).
+  int inner = 0;
   // kSeam only: found past the symmetric search window, in its outward
   // extension (see OutwardSeamsNeedEverySide).
   bool outward_seam = false;
-  // kContinues only: the plane ends within the band past the side, here.
+  // kContinues only: where the face's points end within the band.
   bool rim = false;
   double rim_position = 0.0, rim_slope = 0.0;
   bool measured() const { return kind == SideKind::kFree || kind == SideKind::kSeam; }
@@ -519,7 +486,7 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
   }
   SideMeasure m;
   if (inner < 10) return m;  // hidden or cut: no say
-  m.further_share = static_cast<double>(face.further[side]) / inner;
+  m.inner = inner;
   // Something in front of the plane just past the side: the face may go on
   // underneath it, so the side is not where the face ends.
   int in_front = 0;
@@ -565,9 +532,9 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
       m.outward_seam = *seam - half > o.seam_search_m - 0.0015;
     } else {
       m.kind = SideKind::kContinues;
-      // ... or only its rim does: the plane ends within the band (nothing
-      // of it a band further out), where a free side may be (RimAsFree).
-      if (o.rim_ends_side && m.further_share <= o.free_side_ratio) {
+      // ... or only its rim does, ending within the band: where it ends,
+      // for RimAsFree to decide.
+      if (o.rim_ends_side) {
         SideMeasure end;
         if (measure_end(&end)) {
           m.rim_position = end.position;
@@ -597,28 +564,72 @@ void OutwardSeamsNeedEverySide(std::array<SideMeasure*, 4> sides) {
   }
 }
 
+// Points on the face's plane (within twice its tolerance: a plane fitted
+// to a small, noisy face may be off by degrees, which a band further out
+// magnifies) one band past `side` (margin to twice it out, clear of the
+// corners), over the points just inside the side: whether a face that runs
+// past the side goes on, or ends within the band.
+double FurtherShare(const DepthImage& depth, const FaceFrame& f, int side, int inner,
+                    double margin, double plane_tol) {
+  if (inner <= 0) return 0.0;
+  const bool along_a = side < 2;
+  const double sign = side % 2 == 0 ? 1.0 : -1.0;
+  const Eigen::Vector3d across = sign * (along_a ? f.a : f.b), along = along_a ? f.b : f.a;
+  const double half = along_a ? f.half_a : f.half_b;
+  const double reach = (along_a ? f.half_b : f.half_a) - margin;
+  if (reach <= 0.0) return 0.0;
+  std::vector<Eigen::Vector3d> strip;
+  for (double out : {half + margin, half + 2.0 * margin}) {
+    for (double s : {-reach, reach}) strip.push_back(f.c + out * across + s * along);
+  }
+  const std::optional<PixelRect> r = ProjectedRect(depth.camera, strip);
+  if (!r) return 0.0;
+  // Pixels more all round: a point off the plane (up to twice its
+  // tolerance) lands beside the strip's image.
+  const CameraIntrinsics& k = depth.camera;
+  const int slack = 1 + static_cast<int>(std::ceil(2.0 * plane_tol * k.fx / std::max(0.1, f.c.z())));
+  int further = 0;
+  for (int v = std::max(0, r->v0 - slack); v <= std::min(k.height - 1, r->v1 + slack); ++v) {
+    for (int u = std::max(0, r->u0 - slack); u <= std::min(k.width - 1, r->u1 + slack); ++u) {
+      const float z = depth.at(u, v);
+      if (std::isnan(z)) continue;
+      const Eigen::Vector3d d = static_cast<double>(z) * PixelRay(k, u, v) - f.c;
+      if (std::abs(d.dot(f.n)) > 2.0 * plane_tol) continue;
+      const double out = d.dot(across);
+      further += out > half + margin && out <= half + 2.0 * margin && std::abs(d.dot(along)) <= reach;
+    }
+  }
+  return static_cast<double>(further) / inner;
+}
+
 // A face whose rim spreads past one side (a bulging carton; an active stereo
 // camera's fattened edges and smoothing; noise at a crease seen obliquely)
 // runs on past that side by a centimetre or so and then ends: the side is
 // free where the face ends, when that is the only side in doubt: its
 // opposite side free, and every side of the face measured (a side hidden or
-// cut would leave the face's true size open).
+// cut would leave the face's true size open). `further(i)` is side i's
+// FurtherShare (read only for the few faces that get that far).
+template <typename Further>
 void RimAsFree(std::array<SideMeasure*, 4> sides, double half_a, double half_b,
-               const RefinementOptions& o) {
-  int rims = 0, unknown = 0, rim = -1;
+               const RefinementOptions& o, const Further& further) {
+  for (const SideMeasure* m : sides) {
+    if (m->kind == SideKind::kUnknown || m->kind == SideKind::kOccluded) return;
+  }
+  // A rim: the face runs on past the side, but nothing of it a band further.
+  int rims = 0, rim = -1;
   for (int i = 0; i < 4; ++i) {
-    if (sides[i]->kind == SideKind::kContinues && sides[i]->rim) {
+    if (sides[i]->kind == SideKind::kContinues && sides[i]->rim &&
+        further(i) <= o.free_side_ratio) {
       ++rims;
       rim = i;
     }
-    unknown += sides[i]->kind == SideKind::kUnknown || sides[i]->kind == SideKind::kOccluded;
   }
-  if (rims != 1 || unknown > 0) return;
+  if (rims != 1) return;
   // The opposite side must end the face for good: no plane resuming past
   // it (a strip of missing returns across a face, as dark tape leaves on a
   // stereo camera, ends half of it at a free side).
   const SideMeasure& opposite = *sides[rim ^ 1];
-  if (opposite.kind != SideKind::kFree || opposite.further_share > o.free_side_ratio) return;
+  if (opposite.kind != SideKind::kFree || further(rim ^ 1) > o.free_side_ratio) return;
   // The face so measured is the box's size on both axes: across the rim
   // from rim_extent_tolerance_m short to twice it long (the rim adds to
   // it), along it within the tolerance when both its sides are free (a face
@@ -833,8 +844,7 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
                 RefinementResult& result) {
   FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
   thread_local FacePoints face;  // reused: its vectors keep their capacity
-  CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m,
-                    options.rim_ends_side, &face);
+  CollectFacePoints(depth, f, options.side_band_m, options.plane_tolerance_m, &face);
   const double pixel_m = f.c.z() / depth.camera.fx;  // point spacing on the face
   // Plane through the interior points: their scatter about the mean is
   // sum(q q^T) - n mean mean^T (face coordinates are centimetres to a
@@ -873,7 +883,13 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
     ColourSeamSide(depth, f, false, -1.0, options, &mb);
   }
   OutwardSeamsNeedEverySide({&pa, &ma, &pb, &mb});
-  if (options.rim_ends_side) RimAsFree({&pa, &ma, &pb, &mb}, f.half_a, f.half_b, options);
+  if (options.rim_ends_side) {
+    const std::array<SideMeasure*, 4> sides = {&pa, &ma, &pb, &mb};
+    RimAsFree(sides, f.half_a, f.half_b, options, [&](int i) {
+      return FurtherShare(depth, f, i, sides[i]->inner, options.side_band_m,
+                          options.plane_tolerance_m);
+    });
+  }
   result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
   result.free_sides = 0;
   for (SideKind k : result.sides) result.free_sides += k == SideKind::kFree;
