@@ -221,7 +221,6 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
     *reason = "grasp face cut by the image border";
     return false;
   }
-  if (getenv("CP_DEBUG")) fprintf(stderr, "  ACCEPT %.3f %.3f %.3f grasp %d sides %d %d %d %d ext %.3f %.3f\n", cand.box.camera_T_box.translation().x(), cand.box.camera_T_box.translation().y(), cand.box.camera_T_box.translation().z(), (int)grasp, (int)cand.refinement.sides[0], (int)cand.refinement.sides[1], (int)cand.refinement.sides[2], (int)cand.refinement.sides[3], cand.refinement.extent_a_m, cand.refinement.extent_b_m);
   cand.box.score = score;
   cand.box.measured_extent_m = {cand.refinement.extent_a_m, cand.refinement.extent_b_m};
   cand.box.grasp_face = cand.evidence.grasp_face;
