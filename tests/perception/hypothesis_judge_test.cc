@@ -17,8 +17,11 @@ struct OneBox {
   DepthImage depth;
 };
 
-OneBox RenderOneBox() {
+// `cx`: the camera's principal point (a small one puts the box, which the
+// camera looks at, at the image's left edge).
+OneBox RenderOneBox(double cx = CameraIntrinsics{}.cx) {
   Scene scene;
+  scene.camera.cx = cx;
   scene.world_T_camera = LookAtCamera(Eigen::Vector3d::Zero(), 1.2, 10.0, 20.0, 0.0);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.translation().z() = kCartonS.h / 2.0;
@@ -74,6 +77,24 @@ TEST(HypothesisJudgeTest, AnAcceptedPoseIsNotJudgedAgain) {
   EXPECT_TRUE(judge.Evaluate(1).empty());
   EXPECT_EQ(judge.stats().proposed, 1);
   EXPECT_EQ(judge.stats().refined, 1);
+}
+
+// A pose whose grasp face runs out of the image but whose face centre is in
+// view goes on to refinement when a face measured on every side may leave
+// the view (the final check then decides); with that rule off, the first
+// look drops it, as before.
+TEST(HypothesisJudgeTest, AFaceLeavingTheViewIsRefinedWhenItMayBeMeasuredThere) {
+  const OneBox b = RenderOneBox(/*cx=*/30.0);
+  const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;
+  for (const bool may_leave : {true, false}) {
+    DetectorOptions o;
+    o.box = kCartonS;
+    o.acceptance.measured_face_may_leave_view = may_leave;
+    internal::HypothesisJudge judge(b.depth, o);
+    judge.Propose(gt, 0, {});
+    judge.Evaluate(1);
+    EXPECT_EQ(judge.stats().refined, may_leave ? 1 : 0) << may_leave;
+  }
 }
 
 }  // namespace

@@ -191,8 +191,14 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
     return false;
   }
   // Unrefined corners can be a centimetre off: only the refined face must
-  // lie inside the image (checked below).
-  if (!GraspFaceInView(p.camera_T_box, grasp, -20.0)) return false;
+  // lie inside the image (checked below). Where a face measured on every
+  // side may leave the view, that check decides: here its centre need only
+  // be in view (a neighbour of a box found, out past the image's edge).
+  if (!GraspFaceInView(p.camera_T_box, grasp, -20.0) &&
+      !(options_.acceptance.measured_face_may_leave_view &&
+        GraspCentreInView(p.camera_T_box, grasp))) {
+    return false;
+  }
   *refined = true;
   cand.box.score = first.support();  // what a declined candidate reports
   cand.refinement =
@@ -243,6 +249,16 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
 // gripper aimed at its centre may miss the box): such boxes are not
 // returned, unless every side was found where the face ends
 // (PinnedOnEverySide).
+bool HypothesisJudge::GraspCentreInView(const Eigen::Isometry3d& pose, BoxFace face) const {
+  const int f = static_cast<int>(face);
+  Eigen::Vector3d local = Eigen::Vector3d::Zero();
+  local[f / 2] = (f % 2 == 0 ? 0.5 : -0.5) * options_.box[f / 2];
+  const Eigen::Vector3d c = pose * local;
+  if (c.z() <= 0.05) return false;
+  const Eigen::Vector2d px = Project(depth_.camera, c);
+  return depth_.inside(static_cast<int>(std::floor(px.x())), static_cast<int>(std::floor(px.y())));
+}
+
 bool HypothesisJudge::GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face,
                                       double margin) const {
   const int f = static_cast<int>(face);
