@@ -383,8 +383,13 @@ absl::Status PrepareFrame(const PointCloud& input, const DetectorOptions& option
   if (options.edge_lattice_radius_px > 0.0) {
     const double radius_px =
         median_z > 0.0 ? options.edge_points.radius_m * f->camera.fx / median_z : 0.0;
-    options.edge_points.lattice_px = std::clamp(
-        static_cast<int>(radius_px / options.edge_lattice_radius_px), 1, kMaxEdgeLattice);
+    // Clamped before the cast: a tiny edge_lattice_radius_px (valid, > 0)
+    // makes the ratio too large for an int (found by detect_request_fuzzer).
+    const double lattice = radius_px / options.edge_lattice_radius_px;
+    options.edge_points.lattice_px =
+        std::isfinite(lattice)
+            ? static_cast<int>(std::clamp(lattice, 1.0, static_cast<double>(kMaxEdgeLattice)))
+            : 1;
   }
   return absl::OkStatus();
 }

@@ -131,6 +131,26 @@ TEST(InputBoundsTest, NearZeroDepthsInAFrameAreDroppedAsNoReturn) {
   EXPECT_FALSE(flat_det->boxes.empty());
 }
 
+// Found by detect_request_fuzzer: a tiny (valid, > 0) edge_lattice_radius_px
+// made r_s / it, in pixels, too large for an int, cast before it was clamped
+// (undefined behaviour; on x86 the lattice became 1). Now clamped first: the
+// same lattice as any radius small enough to reach the cap.
+TEST(InputBoundsTest, ATinyLatticeRadiusGivesTheWidestLattice) {
+  const absl::StatusOr<BoxDims> dims = BoxModelByName("carton_s");
+  ASSERT_TRUE(dims.ok());
+  const RenderedScene scene = Render(MakeIsolatedScene(*dims, 3, 1), NoiseOptions{});
+  DetectorOptions options;
+  options.box = *dims;
+  options.edge_lattice_radius_px = 1e-3;  // r_s is ~20 px: 20000, at the cap
+  const absl::StatusOr<Detection> capped = DetectBoxes(scene.cloud, options);
+  ASSERT_TRUE(capped.ok()) << capped.status();
+  options.edge_lattice_radius_px = 1e-35;
+  ASSERT_TRUE(options.Validate().ok());
+  const absl::StatusOr<Detection> tiny = DetectBoxes(scene.cloud, options);
+  ASSERT_TRUE(tiny.ok()) << tiny.status();
+  EXPECT_EQ(tiny->edge_points.size(), capped->edge_points.size());
+}
+
 // The stall of issue 11: 200 000 identical points sent the detector to the
 // k-d tree path, where every radius search returned all 200 000.
 TEST(InputBoundsTest, IdenticalPointsCostOneNeighbourEach) {
