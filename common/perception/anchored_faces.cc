@@ -45,9 +45,9 @@ struct Anchored {
 }  // namespace
 
 absl::Status AnchoredFaceOptions::Validate() const {
-  for (const auto& [name, value] : {std::pair{"min_inside", min_inside},
-                                    std::pair{"min_edge", min_edge},
-                                    std::pair{"max_beyond", max_beyond}}) {
+  for (const auto& [name, value] :
+       {std::pair{"min_inside", min_inside}, std::pair{"min_edge", min_edge},
+        std::pair{"max_beyond", max_beyond}}) {
     if (!(value >= 0.0 && value <= 1.0)) {
       return absl::InvalidArgumentError(
           absl::StrCat("faces.anchored.", name, "=", value, " is outside [0, 1]"));
@@ -69,8 +69,7 @@ std::vector<Eigen::Isometry3d> AnchoredFaces(const PlanarPatch& patch, const Pla
                                              const BoxDims& dims, const AnchoredFaceOptions& o) {
   std::vector<Eigen::Isometry3d> out;
   if (!o.enabled || !(cell_m > 1e-4) || patch.points.empty()) return out;
-  const double largest_face =
-      std::max({dims.l * dims.b, dims.l * dims.h, dims.b * dims.h});
+  const double largest_face = std::max({dims.l * dims.b, dims.l * dims.h, dims.b * dims.h});
   if (rect.width * rect.height > o.max_faces * largest_face) return out;
   // The raster: the outline rectangle and a margin of kMargin cells, one
   // cell per point spacing (bounded: a patch this big is already refused).
@@ -98,7 +97,8 @@ std::vector<Eigen::Isometry3d> AnchoredFaces(const PlanarPatch& patch, const Pla
         for (int dj = -1; dj <= 1; ++dj) {
           for (int di = -1; di <= 1; ++di) {
             const int x = i + di, y = j + dj;
-            const bool set = x >= 0 && y >= 0 && x < w && y < h && in[static_cast<size_t>(y) * w + x];
+            const bool set =
+                x >= 0 && y >= 0 && x < w && y < h && in[static_cast<size_t>(y) * w + x];
             any |= set;
             all &= set;
           }

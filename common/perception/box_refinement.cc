@@ -509,6 +509,7 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
     }
     if (static_cast<int>(ends.size()) < std::max(3, nbins / 3)) return false;
     std::vector<double> across;
+    across.reserve(ends.size());
     for (auto& e : ends) across.push_back(e.second);
     out->position = Median(across);
     // Slope by the median of pairwise slopes (Theil-Sen) over bins far apart.
@@ -569,8 +570,8 @@ void OutwardSeamsNeedEverySide(std::array<SideMeasure*, 4> sides) {
 // magnifies) one band past `side` (margin to twice it out, clear of the
 // corners), over the points just inside the side: whether a face that runs
 // past the side goes on, or ends within the band.
-double FurtherShare(const DepthImage& depth, const FaceFrame& f, int side, int inner,
-                    double margin, double plane_tol) {
+double FurtherShare(const DepthImage& depth, const FaceFrame& f, int side, int inner, double margin,
+                    double plane_tol) {
   if (inner <= 0) return 0.0;
   const bool along_a = side < 2;
   const double sign = side % 2 == 0 ? 1.0 : -1.0;
@@ -587,7 +588,8 @@ double FurtherShare(const DepthImage& depth, const FaceFrame& f, int side, int i
   // Pixels more all round: a point off the plane (up to twice its
   // tolerance) lands beside the strip's image.
   const CameraIntrinsics& k = depth.camera;
-  const int slack = 1 + static_cast<int>(std::ceil(2.0 * plane_tol * k.fx / std::max(0.1, f.c.z())));
+  const int slack =
+      1 + static_cast<int>(std::ceil(2.0 * plane_tol * k.fx / std::max(0.1, f.c.z())));
   int further = 0;
   for (int v = std::max(0, r->v0 - slack); v <= std::min(k.height - 1, r->v1 + slack); ++v) {
     for (int u = std::max(0, r->u0 - slack); u <= std::min(k.width - 1, r->u1 + slack); ++u) {
@@ -596,7 +598,8 @@ double FurtherShare(const DepthImage& depth, const FaceFrame& f, int side, int i
       const Eigen::Vector3d d = static_cast<double>(z) * PixelRay(k, u, v) - f.c;
       if (std::abs(d.dot(f.n)) > 2.0 * plane_tol) continue;
       const double out = d.dot(across);
-      further += out > half + margin && out <= half + 2.0 * margin && std::abs(d.dot(along)) <= reach;
+      further +=
+          out > half + margin && out <= half + 2.0 * margin && std::abs(d.dot(along)) <= reach;
     }
   }
   return static_cast<double>(further) / inner;

@@ -36,8 +36,7 @@ PointCloud WallWithNearPoints(int near) {
   for (int i = 0; i < near; ++i) {
     const int u = 70 + 3 * i, v = 55 + i;  // > 64 px from every border
     const float z = 1e-9f;
-    cloud.xyz[v * k.width + u] =
-        Eigen::Vector3f((u - k.cx) * z / k.fx, (v - k.cy) * z / k.fy, z);
+    cloud.xyz[v * k.width + u] = Eigen::Vector3f((u - k.cx) * z / k.fx, (v - k.cy) * z / k.fy, z);
   }
   return cloud;
 }
@@ -66,8 +65,7 @@ TEST(InputBoundsTest, IntrinsicsOutsidePlausibleRangesNameFieldValueAndRange) {
   CameraIntrinsics k;
   EXPECT_TRUE(k.Validate().ok());
   k.fx = 1e12;
-  EXPECT_THAT(std::string(k.Validate().message()),
-              HasSubstr("fx=1e+12 px is outside [1, 100000]"));
+  EXPECT_THAT(std::string(k.Validate().message()), HasSubstr("fx=1e+12 px is outside [1, 100000]"));
   k = CameraIntrinsics{};
   k.fy = 0.5;
   EXPECT_THAT(std::string(k.Validate().message()), HasSubstr("fy=0.5 px is outside [1, 100000]"));
@@ -181,7 +179,8 @@ TEST(InputBoundsTest, ADenseBlockCostsABoundedNumberOfNeighboursPerPoint) {
   constexpr int kSide = 21;  // 20 mm cube
   for (int i = 0; i < kSide; ++i) {
     for (int j = 0; j < kSide; ++j) {
-      for (int l = 0; l < kSide; ++l) cloud.xyz.emplace_back(0.001f * i, 0.001f * j, 1.0f + 0.001f * l);
+      for (int l = 0; l < kSide; ++l)
+        cloud.xyz.emplace_back(0.001f * i, 0.001f * j, 1.0f + 0.001f * l);
     }
   }
   cloud.width = static_cast<int>(cloud.xyz.size());
