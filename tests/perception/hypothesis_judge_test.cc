@@ -79,12 +79,26 @@ TEST(HypothesisJudgeTest, AnAcceptedPoseIsNotJudgedAgain) {
   EXPECT_EQ(judge.stats().refined, 1);
 }
 
-// A pose whose grasp face runs out of the image but whose face centre is in
-// view goes on to refinement when a face measured on every side may leave
-// the view (the final check then decides); with that rule off, the first
-// look drops it, as before.
+// A pose whose grasp face runs out of the image but whose face centre and
+// some of each side are in view goes on to refinement when a face measured
+// on every side may leave the view (the final check then decides); with
+// that rule off, the first look drops it, as before; and so it does, rule
+// or not, when a whole side is out of view (that side cannot be measured).
+// With the principal point at u = 64 the face's far-left corner lies at
+// u = -24 and its left side's upper quarter point at u = 3; at u = 30 the
+// whole left side is out.
 TEST(HypothesisJudgeTest, AFaceLeavingTheViewIsRefinedWhenItMayBeMeasuredThere) {
-  const OneBox b = RenderOneBox(/*cx=*/30.0);
+  const OneBox out_a_side = RenderOneBox(/*cx=*/30.0);
+  for (const bool may_leave : {true, false}) {
+    DetectorOptions o;
+    o.box = kCartonS;
+    o.acceptance.measured_face_may_leave_view = may_leave;
+    internal::HypothesisJudge judge(out_a_side.depth, o);
+    judge.Propose(out_a_side.out.boxes.at(0).camera_T_box, 0, {});
+    judge.Evaluate(1);
+    EXPECT_EQ(judge.stats().refined, 0) << may_leave;
+  }
+  const OneBox b = RenderOneBox(/*cx=*/64.0);
   const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;
   for (const bool may_leave : {true, false}) {
     DetectorOptions o;

@@ -192,11 +192,12 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   }
   // Unrefined corners can be a centimetre off: only the refined face must
   // lie inside the image (checked below). Where a face measured on every
-  // side may leave the view, that check decides: here its centre need only
-  // be in view (a neighbour of a box found, out past the image's edge).
+  // side may leave the view, that check decides: here its centre and some
+  // of each of its sides need only be in view (a neighbour of a box found,
+  // out past the image's edge).
   if (!GraspFaceInView(p.camera_T_box, grasp, -20.0) &&
       !(options_.acceptance.measured_face_may_leave_view &&
-        GraspCentreInView(p.camera_T_box, grasp))) {
+        GraspFaceMeasurable(p.camera_T_box, grasp))) {
     return false;
   }
   *refined = true;
@@ -249,14 +250,32 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
 // gripper aimed at its centre may miss the box): such boxes are not
 // returned, unless every side was found where the face ends
 // (PinnedOnEverySide).
-bool HypothesisJudge::GraspCentreInView(const Eigen::Isometry3d& pose, BoxFace face) const {
+bool HypothesisJudge::GraspFaceMeasurable(const Eigen::Isometry3d& pose, BoxFace face) const {
   const int f = static_cast<int>(face);
-  Eigen::Vector3d local = Eigen::Vector3d::Zero();
-  local[f / 2] = (f % 2 == 0 ? 0.5 : -0.5) * options_.box[f / 2];
-  const Eigen::Vector3d c = pose * local;
-  if (c.z() <= 0.05) return false;
-  const Eigen::Vector2d px = Project(depth_.camera, c);
-  return depth_.inside(static_cast<int>(std::floor(px.x())), static_cast<int>(std::floor(px.y())));
+  const int n = f / 2, a = (n + 1) % 3, b = (n + 2) % 3;
+  auto in_view = [&](double sa, double sb) {
+    Eigen::Vector3d local = Eigen::Vector3d::Zero();
+    local[n] = (f % 2 == 0 ? 0.5 : -0.5) * options_.box[n];
+    local[a] = sa * options_.box[a];
+    local[b] = sb * options_.box[b];
+    const Eigen::Vector3d c = pose * local;
+    if (c.z() <= 0.05) return false;
+    const Eigen::Vector2d px = Project(depth_.camera, c);
+    return depth_.inside(static_cast<int>(std::floor(px.x())),
+                         static_cast<int>(std::floor(px.y())));
+  };
+  if (!in_view(0.0, 0.0)) return false;
+  // Every side needs some of its length in view to be measured, which a
+  // face leaving the view must be on all four (PinnedOnEverySide).
+  for (const double s : {-0.5, 0.5}) {
+    bool a_side = false, b_side = false;
+    for (const double t : {-0.25, 0.0, 0.25}) {
+      a_side = a_side || in_view(s, t);
+      b_side = b_side || in_view(t, s);
+    }
+    if (!a_side || !b_side) return false;
+  }
+  return true;
 }
 
 bool HypothesisJudge::GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face,

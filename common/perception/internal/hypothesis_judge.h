@@ -68,7 +68,9 @@ class HypothesisJudge {
   // out->box holds the refined pose and out->box.score its first support.
   bool EvaluateOne(const Proposal& p, Candidate* out, bool* refined, std::string* reason) const;
   bool GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face, double margin) const;
-  bool GraspCentreInView(const Eigen::Isometry3d& pose, BoxFace face) const;
+  // The grasp face's centre in view, and on each side a point (at a
+  // quarter, half or three quarters of it).
+  bool GraspFaceMeasurable(const Eigen::Isometry3d& pose, BoxFace face) const;
   bool Seen(const Eigen::Isometry3d& pose) const;
   // The index in `poses` of one like `pose` (within 1 cm, axes within
   // ~2.5 degrees up to the box's symmetries), or -1.
