@@ -83,6 +83,8 @@ constexpr char kHelp[] =
     "                       flight multipath in concave creases; 0.025; 0: off)\n"
     "  --seam_outward M    a seam is looked for 6 mm either side of a side and M\n"
     "                       further out (0.004; 0: symmetric)\n"
+    "  --layer_down BOOL    a box found proposes the boxes beside it a layer down too\n"
+    "                       (a pallet stacked at two heights; true)\n"
     "  --rim_sides BOOL     a side where the face runs on but ends within 2 cm is free\n"
     "                       there, when it is the face's only side in doubt (true)\n"
     "  --anchored_faces BOOL a planar patch that does not tile (an L of box tops, a\n"
@@ -139,6 +141,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("border_faces", &options.faces.propose_at_border),
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
+        args.SetBool("layer_down", &options.neighbours_a_layer_down),
         args.SetDouble("seam_outward", &options.refinement.seam_search_outward_m),
         args.SetBool("retry_declined", &options.retry_declined),
         args.SetInt("patch_window", &options.faces.patches.window_cells),
@@ -243,6 +246,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "border_faces",
                                                        "anchored_faces",
                                                        "rim_sides",
+                                                       "layer_down",
                                                        "seam_outward",
                                                        "retry_declined",
                                                        "patch_window"},

@@ -517,7 +517,8 @@ class BoxAcceptance {
         sides_of_.push_back(c.refinement.sides);
         if (options_.propagate_to_neighbours) {
           for (const Eigen::Isometry3d& pose :
-               NeighbourHypotheses(c.box, options_.box, options_.neighbour_gap_m)) {
+               NeighbourHypotheses(c.box, options_.box, options_.neighbour_gap_m,
+                                   options_.neighbours_a_layer_down)) {
             judge_->Propose(pose, 0, {});
           }
         }

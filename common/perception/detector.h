@@ -119,6 +119,11 @@ struct DetectorOptions {
   // (pallet layers, where seams leave few edges), neighbour_gap_m apart.
   bool propagate_to_neighbours = true;
   double neighbour_gap_m = 0.002;
+  // ... and the boxes beside it a layer down (one box height below, in its
+  // orientation): on a pallet stacked at two heights, the lower layer's
+  // boxes next to an upper one (their patches often in pieces at a stereo
+  // camera's range, their corners against the upper box's wall).
+  bool neighbours_a_layer_down = true;
   // Unorganized clouds are projected through `camera` onto its pixel grid
   // (the nearest point per pixel) and processed like a frame. Right for a
   // cloud from one depth camera, in its frame; for merged or foreign clouds

@@ -6,7 +6,7 @@
 namespace cornerpose {
 
 std::vector<Eigen::Isometry3d> NeighbourHypotheses(const DetectedBox& box, const BoxDims& dims,
-                                                   double gap_m) {
+                                                   double gap_m, bool layer_down) {
   const int face = static_cast<int>(box.grasp_face);
   const int axis_n = face / 2, axis_a = (axis_n + 1) % 3, axis_b = (axis_n + 2) % 3;
   const Eigen::Matrix3d R = box.camera_T_box.linear();
@@ -33,9 +33,14 @@ std::vector<Eigen::Isometry3d> NeighbourHypotheses(const DetectedBox& box, const
                          {-R.col(axis_a), R.col(axis_b), A / 2, B / 2},
                          {R.col(axis_b), R.col(axis_a), B / 2, A / 2},
                          {-R.col(axis_b), R.col(axis_a), B / 2, A / 2}};
+  // A layer down: on a pallet stacked at two heights, the boxes of the lower
+  // layer beside the upper one lie one box height below it (the grasp
+  // face's normal, pointing out of the box, is up).
+  const Eigen::Vector3d down = -(face % 2 == 0 ? 1.0 : -1.0) * dims[axis_n] * R.col(axis_n);
   for (const Side& s : sides) {
-    // Same orientation: straight across.
+    // Same orientation: straight across, on its level and a layer down.
     add(R, t + (2 * s.half_across + gap_m) * s.across);
+    if (layer_down) add(R, t + (2 * s.half_across + gap_m) * s.across + down);
     // Turned: across it the neighbour is half_along deep, along it
     // half_across long; flush with either end of the shared side.
     const double shift = s.half_along - s.half_across;

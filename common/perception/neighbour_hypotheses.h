@@ -14,8 +14,10 @@
 namespace cornerpose {
 
 // Poses of the boxes that would touch `box` side by side across each of the
-// four sides of its grasp face, `gap_m` apart (metres).
+// four sides of its grasp face, `gap_m` apart (metres); with `layer_down`,
+// also the same-orientation ones a box height lower (a pallet stacked at two
+// heights: the lower layer beside an upper box).
 std::vector<Eigen::Isometry3d> NeighbourHypotheses(const DetectedBox& box, const BoxDims& dims,
-                                                   double gap_m);
+                                                   double gap_m, bool layer_down = false);
 
 }  // namespace cornerpose
