@@ -551,15 +551,19 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
   return m;
 }
 
+// No side of the face hidden under something or cut by the image's edge.
+bool EverySideSeen(const std::array<SideMeasure*, 4>& sides) {
+  return std::none_of(sides.begin(), sides.end(), [](const SideMeasure* m) {
+    return m->kind == SideKind::kUnknown || m->kind == SideKind::kOccluded;
+  });
+}
+
 // A seam found only in the outward extension of the search is kept when
 // every side of the face is measured (none hidden or cut): a face pinned
 // by such a seam and a side out of sight was, on the generated pallets, a
 // box's end face carved out of a longer top by Kinect noise.
-void OutwardSeamsNeedEverySide(std::array<SideMeasure*, 4> sides) {
-  const bool all_seen = std::none_of(sides.begin(), sides.end(), [](const SideMeasure* m) {
-    return m->kind == SideKind::kUnknown || m->kind == SideKind::kOccluded;
-  });
-  if (all_seen) return;
+void OutwardSeamsNeedEverySide(const std::array<SideMeasure*, 4>& sides) {
+  if (EverySideSeen(sides)) return;
   for (SideMeasure* m : sides) {
     if (m->kind == SideKind::kSeam && m->outward_seam) m->kind = SideKind::kContinues;
   }
@@ -613,11 +617,9 @@ double FurtherShare(const DepthImage& depth, const FaceFrame& f, int side, int i
 // cut would leave the face's true size open). `further(i)` is side i's
 // FurtherShare (read only for the few faces that get that far).
 template <typename Further>
-void RimAsFree(std::array<SideMeasure*, 4> sides, double half_a, double half_b,
+void RimAsFree(const std::array<SideMeasure*, 4>& sides, double half_a, double half_b,
                const RefinementOptions& o, const Further& further) {
-  for (const SideMeasure* m : sides) {
-    if (m->kind == SideKind::kUnknown || m->kind == SideKind::kOccluded) return;
-  }
+  if (!EverySideSeen(sides)) return;
   // A rim: the face runs on past the side, but nothing of it a band further.
   int rims = 0, rim = -1;
   for (int i = 0; i < 4; ++i) {
@@ -885,9 +887,9 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
     ColourSeamSide(depth, f, false, 1.0, options, &pb);
     ColourSeamSide(depth, f, false, -1.0, options, &mb);
   }
-  OutwardSeamsNeedEverySide({&pa, &ma, &pb, &mb});
+  const std::array<SideMeasure*, 4> sides = {&pa, &ma, &pb, &mb};
+  OutwardSeamsNeedEverySide(sides);
   if (options.rim_ends_side) {
-    const std::array<SideMeasure*, 4> sides = {&pa, &ma, &pb, &mb};
     RimAsFree(sides, f.half_a, f.half_b, options, [&](int i) {
       return FurtherShare(depth, f, i, sides[i]->inner, options.side_band_m,
                           options.plane_tolerance_m);

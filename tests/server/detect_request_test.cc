@@ -176,6 +176,16 @@ TEST(CloudFromRequestTest, ColourImageBecomesTheCloudsColour) {
   EXPECT_THAT(s.message(), HasSubstr("cloud.rgb or color, not both"));
 }
 
+// A serialized DetectRequest from a file (a fuzzer's seed or finding);
+// false when the file is missing or does not parse.
+bool ReadRequest(const std::string& path, v1::DetectRequest* request) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  return request->ParseFromString(bytes.str());
+}
+
 // The DetectRequest fuzzer's seeds (fuzz/corpus/detect_request_fuzzer,
 // written by fuzz/make_seeds.py) are requests the service serves: each one
 // parses, converts and, but for the unknown source, is detected. A seed
@@ -187,12 +197,8 @@ TEST(DetectRequestFuzzSeedsTest, EverySeedReachesTheDetector) {
        {"depth_mm_carton.bin", "depth_m_grey_overrides.bin", "organized_cloud_rgb.bin",
         "unorganized_cloud_camera.bin", "source.bin"}) {
     SCOPED_TRACE(name);
-    std::ifstream in(dir + name, std::ios::binary);
-    ASSERT_TRUE(in) << "missing seed " << dir << name;
-    std::stringstream bytes;
-    bytes << in.rdbuf();
     v1::DetectRequest request;
-    ASSERT_TRUE(request.ParseFromString(bytes.str()));
+    ASSERT_TRUE(ReadRequest(dir + name, &request)) << "missing or unreadable " << dir << name;
     absl::StatusOr<DetectorOptions> options = DetectorOptionsFromRequest(request, {});
     ASSERT_TRUE(options.ok()) << options.status();
     absl::StatusOr<PointCloud> cloud = CloudFromRequest(request);
@@ -221,12 +227,8 @@ TEST(DetectRequestFuzzSeedsTest, EverySeedReachesTheDetector) {
 TEST(DetectRequestFuzzSeedsTest, FindingsAreServedWithAStatus) {
   const std::string path =
       std::string(CORNERPOSE_SOURCE_DIR) + "/tests/data/fuzz/detect_request_tiny_lattice.bin";
-  std::ifstream in(path, std::ios::binary);
-  ASSERT_TRUE(in) << "missing " << path;
-  std::stringstream bytes;
-  bytes << in.rdbuf();
   v1::DetectRequest request;
-  ASSERT_TRUE(request.ParseFromString(bytes.str()));
+  ASSERT_TRUE(ReadRequest(path, &request)) << "missing or unreadable " << path;
   absl::StatusOr<DetectorOptions> options = DetectorOptionsFromRequest(request, {});
   ASSERT_TRUE(options.ok()) << options.status();
   absl::StatusOr<PointCloud> cloud = CloudFromRequest(request);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "absl/strings/str_format.h"
 #include "common/perception/internal/parallel.h"
@@ -246,23 +247,44 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   return true;
 }
 
+std::optional<Eigen::Vector2d> HypothesisJudge::GraspFacePixel(const Eigen::Isometry3d& pose,
+                                                               BoxFace face, double sa,
+                                                               double sb) const {
+  const int f = static_cast<int>(face);
+  const int n = f / 2, a = (n + 1) % 3, b = (n + 2) % 3;
+  Eigen::Vector3d local = Eigen::Vector3d::Zero();
+  local[n] = (f % 2 == 0 ? 0.5 : -0.5) * options_.box[n];
+  local[a] = sa * options_.box[a];
+  local[b] = sb * options_.box[b];
+  const Eigen::Vector3d p = pose * local;
+  if (p.z() <= 0.05) return std::nullopt;
+  return Project(depth_.camera, p);
+}
+
 // A face cut by the image border cannot be checked to its end (and a
 // gripper aimed at its centre may miss the box): such boxes are not
 // returned, unless every side was found where the face ends
 // (PinnedOnEverySide).
+bool HypothesisJudge::GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face,
+                                      double margin) const {
+  const CameraIntrinsics& k = depth_.camera;
+  for (double sa : {-0.5, 0.5}) {
+    for (double sb : {-0.5, 0.5}) {
+      const std::optional<Eigen::Vector2d> px = GraspFacePixel(pose, face, sa, sb);
+      if (!px || px->x() < margin || px->y() < margin || px->x() > k.width - 1 - margin ||
+          px->y() > k.height - 1 - margin) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 bool HypothesisJudge::GraspFaceMeasurable(const Eigen::Isometry3d& pose, BoxFace face) const {
-  const int f = static_cast<int>(face);
-  const int n = f / 2, a = (n + 1) % 3, b = (n + 2) % 3;
   auto in_view = [&](double sa, double sb) {
-    Eigen::Vector3d local = Eigen::Vector3d::Zero();
-    local[n] = (f % 2 == 0 ? 0.5 : -0.5) * options_.box[n];
-    local[a] = sa * options_.box[a];
-    local[b] = sb * options_.box[b];
-    const Eigen::Vector3d c = pose * local;
-    if (c.z() <= 0.05) return false;
-    const Eigen::Vector2d px = Project(depth_.camera, c);
-    return depth_.inside(static_cast<int>(std::floor(px.x())),
-                         static_cast<int>(std::floor(px.y())));
+    const std::optional<Eigen::Vector2d> px = GraspFacePixel(pose, face, sa, sb);
+    return px && depth_.inside(static_cast<int>(std::floor(px->x())),
+                               static_cast<int>(std::floor(px->y())));
   };
   if (!in_view(0.0, 0.0)) return false;
   // Every side needs some of its length in view to be measured, which a
@@ -274,29 +296,6 @@ bool HypothesisJudge::GraspFaceMeasurable(const Eigen::Isometry3d& pose, BoxFace
       b_side = b_side || in_view(t, s);
     }
     if (!a_side || !b_side) return false;
-  }
-  return true;
-}
-
-bool HypothesisJudge::GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face,
-                                      double margin) const {
-  const int f = static_cast<int>(face);
-  const int n = f / 2, a = (n + 1) % 3, b = (n + 2) % 3;
-  const CameraIntrinsics& k = depth_.camera;
-  for (double sa : {-0.5, 0.5}) {
-    for (double sb : {-0.5, 0.5}) {
-      Eigen::Vector3d local = Eigen::Vector3d::Zero();
-      local[n] = (f % 2 == 0 ? 0.5 : -0.5) * options_.box[n];
-      local[a] = sa * options_.box[a];
-      local[b] = sb * options_.box[b];
-      const Eigen::Vector3d p = pose * local;
-      if (p.z() <= 0.05) return false;
-      const Eigen::Vector2d px = Project(k, p);
-      if (px.x() < margin || px.y() < margin || px.x() > k.width - 1 - margin ||
-          px.y() > k.height - 1 - margin) {
-        return false;
-      }
-    }
   }
   return true;
 }

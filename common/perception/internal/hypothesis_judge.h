@@ -4,6 +4,7 @@
 // in parallel; each evaluation only reads the depth image.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,10 @@ class HypothesisJudge {
   // got as far as refinement; then `reason` says why it was rejected, and
   // out->box holds the refined pose and out->box.score its first support.
   bool EvaluateOne(const Proposal& p, Candidate* out, bool* refined, std::string* reason) const;
+  // The pixel of a point of the grasp face (sa, sb in [-0.5, 0.5] along its
+  // two axes), or nothing behind the camera.
+  std::optional<Eigen::Vector2d> GraspFacePixel(const Eigen::Isometry3d& pose, BoxFace face,
+                                                double sa, double sb) const;
   bool GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face, double margin) const;
   // The grasp face's centre in view, and on each side a point (at a
   // quarter, half or three quarters of it).
