@@ -64,6 +64,8 @@ constexpr char kHelp[] =
     "  --layer_plane DEG    boxes side by side on one plane (a layer) take the plane\n"
     "                       fitted through all their faces when within DEG of it (12;\n"
     "                       0: every box keeps its own face's plane)\n"
+    "  --layer_adopt DEG    ... and a face tilted up to DEG takes it when its pixels fit\n"
+    "                       the plane about as well as their own (25)\n"
     "  --seam_colour SHARE  with a colour image, a groove in the depth is a seam only\n"
     "                       where an image line runs along SHARE of the side (0.5;\n"
     "                       0: the depth alone)\n"
@@ -85,6 +87,9 @@ constexpr char kHelp[] =
     "                       further out (0.004; 0: symmetric)\n"
     "  --layer_down BOOL    a box found proposes the boxes beside it a layer down too\n"
     "                       (a pallet stacked at two heights; true)\n"
+    "  --past_declined N    a neighbour declined only for a side that runs on flat\n"
+    "                       still proposes its own, up to N declined in a row (2;\n"
+    "                       0: the chain of neighbours stops at the first)\n"
     "  --rim_sides BOOL     a side where the face runs on but ends within 2 cm is free\n"
     "                       there, when it is the face's only side in doubt (true)\n"
     "  --anchored_faces BOOL a planar patch that does not tile (an L of box tops, a\n"
@@ -132,6 +137,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("layer_check", &options.faces.check_layer_tiling),
         args.SetBool("floor_check", &options.floor_check),
         args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
+        args.SetDouble("layer_adopt", &options.layer_plane.adopt_angle_deg),
         args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
         args.SetDouble("sparse_seam", &options.refinement.sparse_seam_missing),
         args.SetDouble("eroded_faces", &options.faces.min_eroded_share),
@@ -142,6 +148,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
         args.SetBool("layer_down", &options.neighbours_a_layer_down),
+        args.SetInt("past_declined", &options.neighbour_steps_past_declined),
         args.SetDouble("seam_outward", &options.refinement.seam_search_outward_m),
         args.SetBool("retry_declined", &options.retry_declined),
         args.SetInt("patch_window", &options.faces.patches.window_cells),
@@ -235,6 +242,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "layer_check",
                                                        "floor_check",
                                                        "layer_plane",
+                                                       "layer_adopt",
                                                        "seam_colour",
                                                        "sparse_seam",
                                                        "eroded_faces",
@@ -247,6 +255,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "anchored_faces",
                                                        "rim_sides",
                                                        "layer_down",
+                                                       "past_declined",
                                                        "seam_outward",
                                                        "retry_declined",
                                                        "patch_window"},

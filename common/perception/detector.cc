@@ -285,6 +285,10 @@ absl::Status DetectorOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("max_declined=", max_declined, " is outside [0, 1000]"));
   }
+  if (neighbour_steps_past_declined < 0 || neighbour_steps_past_declined > 4) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "neighbour_steps_past_declined=", neighbour_steps_past_declined, " is outside [0, 4]"));
+  }
   if (camera) {
     if (absl::Status s = camera->Validate(); !s.ok()) return s;
   }
@@ -499,7 +503,8 @@ class BoxAcceptance {
   // until nothing is left (or the token stops).
   void AcceptAll() {
     std::vector<internal::Candidate> pending = judge_->Evaluate(options_.num_threads);
-    while (!pending.empty() && !cancel_.Stopped()) {
+    std::vector<internal::HypothesisJudge::SteppingStone> stones = judge_->TakeSteppingStones();
+    while ((!pending.empty() || !stones.empty()) && !cancel_.Stopped()) {
       // The reading whose face ends in more free borders goes first, then
       // the higher score: a free border is measured, a seam or a tiling is
       // inferred (two boxes on end side by side have a lying box's outline,
@@ -519,11 +524,20 @@ class BoxAcceptance {
           for (const Eigen::Isometry3d& pose :
                NeighbourHypotheses(c.box, options_.box, options_.neighbour_gap_m,
                                    options_.neighbours_a_layer_down)) {
-            judge_->Propose(pose, 0, {});
+            judge_->ProposeNeighbour(pose);
           }
         }
       }
+      // A declined neighbour's neighbours (DetectorOptions::
+      // neighbour_steps_past_declined): the chain goes on past a seam missed.
+      for (const internal::HypothesisJudge::SteppingStone& stone : stones) {
+        for (const Eigen::Isometry3d& pose :
+             NeighbourHypotheses(stone.box, options_.box, options_.neighbour_gap_m)) {
+          if (!OverlapsKept(pose)) judge_->ProposePastDeclined(pose, stone.steps);
+        }
+      }
       pending = judge_->Evaluate(options_.num_threads);
+      stones = judge_->TakeSteppingStones();
     }
   }
 

@@ -124,6 +124,17 @@ struct DetectorOptions {
   // boxes next to an upper one (their patches often in pieces at a stereo
   // camera's range, their corners against the upper box's wall).
   bool neighbours_a_layer_down = true;
+  // A neighbour so proposed that is declined only because a side of its
+  // face runs on flat (the seam there not seen), with a seam on another
+  // side, still proposes its own neighbours, and so on, up to this many declined boxes in a row
+  // past the last box accepted: in a pallet layer whose fine seams show on some boxes' sides and
+  // not on others', the chain from a box found would stop at the first seam missed, though the
+  // boxes beyond it show theirs. A declined box is never returned; what it proposes is judged like
+  // any hypothesis and, once accepted, refined again from its refined pose, where it must pass the
+  // refinement's part of the test once more (a brick's length across the seam between two bricks,
+  // accepted from a lucky start, moves off there and finds a side running on flat). Count, [0, 4];
+  // 0: the chain stops at the first box declined.
+  int neighbour_steps_past_declined = 2;
   // Unorganized clouds are projected through `camera` onto its pixel grid
   // (the nearest point per pixel) and processed like a frame. Right for a
   // cloud from one depth camera, in its frame; for merged or foreign clouds

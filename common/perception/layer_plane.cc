@@ -76,6 +76,28 @@ void AddFacePixels(const DepthImage& depth, const Face& f, const LayerPlaneOptio
   }
 }
 
+// Whether a face's pixels lie about a plane of normal `normal` (through
+// their own centroid) within max_rms_ratio (plus 1 mm) of their rms about
+// their own best plane: a tilt its noise allows.
+bool FitsPlane(const DepthImage& depth, const Face& f, const Eigen::Vector3d& normal,
+               const LayerPlaneOptions& o) {
+  double c = 0.0;
+  Eigen::Vector3d s1 = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d s2 = Eigen::Matrix3d::Zero();
+  AddFacePixels(depth, f, o, &c, &s1, &s2);
+  if (c < 30.0) return false;
+  const double own_rms = std::sqrt(SmallestVariance(c, s1, s2, nullptr));
+  const Eigen::Vector3d mean = s1 / c;
+  const Eigen::Matrix3d cov = s2 / c - mean * mean.transpose();
+  const double about_rms = std::sqrt(std::max(0.0, normal.dot(cov * normal)));
+  return about_rms <= o.max_rms_ratio * own_rms + 0.001;
+}
+
+bool Touch(const Face& a, const Face& b, const LayerPlaneOptions& o) {
+  return (a.c - b.c).norm() <=
+         o.touch_factor * (std::hypot(a.half_a, a.half_b) + std::hypot(b.half_a, b.half_b));
+}
+
 }  // namespace
 
 absl::Status LayerPlaneOptions::Validate() const {
@@ -83,7 +105,8 @@ absl::Status LayerPlaneOptions::Validate() const {
                          CheckPositive("layer_plane.plane_tolerance_m", plane_tolerance_m, 0.1),
                          CheckPositive("layer_plane.touch_factor", touch_factor, 2.0),
                          CheckRange("layer_plane.side_margin_m", side_margin_m, 0.0, 0.1),
-                         CheckRange("layer_plane.max_rms_ratio", max_rms_ratio, 1.0, 10.0)}) {
+                         CheckRange("layer_plane.max_rms_ratio", max_rms_ratio, 1.0, 10.0),
+                         CheckRange("layer_plane.adopt_angle_deg", adopt_angle_deg, 0.0, 45.0)}) {
     if (!s.ok()) return s;
   }
   return absl::OkStatus();
@@ -102,9 +125,7 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       const Face &fi = faces[i], &fj = faces[j];
-      const double reach = options.touch_factor *
-                           (std::hypot(fi.half_a, fi.half_b) + std::hypot(fj.half_a, fj.half_b));
-      if (fi.n.dot(fj.n) < cos_max || (fi.c - fj.c).norm() > reach ||
+      if (fi.n.dot(fj.n) < cos_max || !Touch(fi, fj, options) ||
           std::abs((fj.c - fi.c).dot(fi.n)) > options.plane_tolerance_m ||
           std::abs((fi.c - fj.c).dot(fj.n)) > options.plane_tolerance_m) {
         continue;
@@ -112,7 +133,36 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
       parent[Root(parent, i)] = Root(parent, j);
     }
   }
+  const double cos_adopt =
+      std::cos(std::max(options.adopt_angle_deg, options.max_angle_deg) * std::numbers::pi / 180.0);
+  // Turns box i onto the plane of `normal`, about its face centre, when
+  // its face is within max_angle_deg of it, or within adopt_angle_deg and
+  // its pixels fit the plane.
+  std::vector<char> taken(n, 0);
   int turned = 0;
+  auto take_plane = [&](int i, const Eigen::Vector3d& normal) {
+    DetectedBox& box = (*boxes)[i];
+    const Eigen::Vector3d to = normal.dot(faces[i].n) < 0.0 ? -normal : normal;
+    const double cos_turn = to.dot(faces[i].n);
+    if (cos_turn < cos_adopt || (cos_turn < cos_max && !FitsPlane(depth, faces[i], to, options))) {
+      return;
+    }
+    // The smallest rotation taking the face's normal onto the plane's,
+    // about the face centre.
+    const Eigen::Matrix3d turn =
+        Eigen::Quaterniond::FromTwoVectors(faces[i].n, to).toRotationMatrix();
+    const int axis = static_cast<int>(box.grasp_face) / 2;
+    box.camera_T_box.linear() = turn * box.camera_T_box.linear();
+    box.camera_T_box.translation() = box.grasp_centre_camera - to * dims[axis] / 2.0;
+    box.grasp_normal_camera = to;
+    taken[i] = 1;
+    ++turned;
+  };
+  struct Layer {
+    Eigen::Vector3d normal, centroid;
+    std::vector<int> members;
+  };
+  std::vector<Layer> layers;
   for (int root = 0; root < n; ++root) {
     if (Root(parent, root) != root) continue;
     std::vector<int> members;
@@ -142,19 +192,28 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
     const double joint_sq = SmallestVariance(count, sum, sum_outer, &normal);
     const double own_rms = std::sqrt(own_sq / count);
     if (std::sqrt(joint_sq) > options.max_rms_ratio * own_rms + 0.001) continue;
-    for (int i : members) {
-      DetectedBox& box = (*boxes)[i];
-      const Eigen::Vector3d to = normal.dot(faces[i].n) < 0.0 ? -normal : normal;
-      if (to.dot(faces[i].n) < cos_max) continue;
-      // The smallest rotation taking the face's normal onto the plane's,
-      // about the face centre.
-      const Eigen::Matrix3d turn =
-          Eigen::Quaterniond::FromTwoVectors(faces[i].n, to).toRotationMatrix();
-      const int axis = static_cast<int>(box.grasp_face) / 2;
-      box.camera_T_box.linear() = turn * box.camera_T_box.linear();
-      box.camera_T_box.translation() = box.grasp_centre_camera - to * dims[axis] / 2.0;
-      box.grasp_normal_camera = to;
-      ++turned;
+    for (int i : members) take_plane(i, normal);
+    layers.push_back({normal, sum / count, std::move(members)});
+  }
+  // Faces tilted past max_angle_deg that touch a layer's member with
+  // their centre on its plane (they joined no group: their tilt is their
+  // noise's) take it when their pixels fit it.
+  if (cos_adopt < cos_max) {
+    for (int j = 0; j < n; ++j) {
+      if (taken[j]) continue;
+      for (const Layer& layer : layers) {
+        if (std::find(layer.members.begin(), layer.members.end(), j) != layer.members.end()) {
+          continue;
+        }
+        const bool touches = std::any_of(layer.members.begin(), layer.members.end(),
+                                         [&](int i) { return Touch(faces[i], faces[j], options); });
+        if (!touches ||
+            std::abs((faces[j].c - layer.centroid).dot(layer.normal)) > options.plane_tolerance_m) {
+          continue;
+        }
+        take_plane(j, layer.normal);
+        if (taken[j]) break;
+      }
     }
   }
   return turned;

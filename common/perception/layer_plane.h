@@ -8,8 +8,10 @@
 // fitted through the interior pixels of all its faces (and must fit them
 // about as well as each face's own plane does), and each box takes
 // that plane's normal, turned about its own face centre: its in-plane turn
-// and position stay its own. A box alone, or tilted further from its
-// neighbours (a carton sitting askew on the layer), keeps its own fit.
+// and position stay its own. A face tilted further (up to adopt_angle_deg)
+// that touches the group takes the plane when its pixels fit it about as
+// well as their own; a box alone, or one whose pixels do not fit the plane
+// (a carton sitting askew on the layer), keeps its own fit.
 #pragma once
 
 #include <vector>
@@ -38,6 +40,15 @@ struct LayerPlaneOptions {
   // it within this times (plus 1 mm) the rms of each face about its own.
   // Unitless, [1, 10].
   double max_rms_ratio = 1.3;
+  // A face tilted further than max_angle_deg from a group's plane, up to
+  // this, still takes it when it touches the group (a member, or a box
+  // touching a member with its face centre on the plane) and its own pixels
+  // lie about the plane's normal within max_rms_ratio (plus 1 mm) of their
+  // rms about their own plane: a brick's face 30 pixels across at 2 m on an
+  // active-stereo camera fits its noise to 15 degrees, and a face really
+  // tilted that far does not fit the layer's plane. Degrees, [0, 45];
+  // at most max_angle_deg turns this off.
+  double adopt_angle_deg = 25.0;
 
   absl::Status Validate() const;
 };

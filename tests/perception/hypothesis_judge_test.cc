@@ -1,6 +1,7 @@
 // The judge's queue: a pose like one already judged is not judged again,
 // but one refined and declined gets one more start from a later proposal
-// (DetectorOptions::retry_declined).
+// (DetectorOptions::retry_declined); a neighbour declined for a side on
+// flat is a stepping stone (DetectorOptions::neighbour_steps_past_declined).
 #include "common/perception/internal/hypothesis_judge.h"
 
 #include <gtest/gtest.h>
@@ -109,6 +110,103 @@ TEST(HypothesisJudgeTest, AFaceLeavingTheViewIsRefinedWhenItMayBeMeasuredThere) 
     judge.Evaluate(1);
     EXPECT_EQ(judge.stats().refined, may_leave ? 1 : 0) << may_leave;
   }
+}
+
+// A row of two cartons and a longer box touching end to end with no gap
+// (1.0 m: no whole number of cartons), and 4 mm beside it a row of two
+// cartons; no noise. No seam between the boxes of the first row, so the
+// hypothesis at either carton there finds its face running on flat, and a
+// seam along the other row. Proposed as a neighbour of a box accepted and
+// declined, it is a stepping stone (its neighbours are still worth
+// judging), one step past the last box accepted; proposed otherwise (a
+// corner's hypothesis), or with no steps allowed, it is not. Proposed by a
+// stepping stone, it is one again while the steps allow.
+TEST(HypothesisJudgeTest, ANeighbourRunningOnFlatIsASteppingStone) {
+  Scene scene;
+  scene.world_T_camera = LookAtCamera(Eigen::Vector3d::Zero(), 1.3, 10.0, 20.0, 0.0);
+  auto add = [&](const BoxDims& dims, double x, double y) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = Eigen::Vector3d(x, y, dims.h / 2.0);
+    scene.boxes.push_back({dims, pose, true});
+  };
+  add(kCartonS, -0.3, 0.0);
+  add(kCartonS, 0.0, 0.0);
+  add(BoxDims{0.40, kCartonS.b, kCartonS.h}, 0.35, 0.0);
+  add(kCartonS, -0.3, kCartonS.b + 0.004);
+  add(kCartonS, 0.0, kCartonS.b + 0.004);
+  NoiseOptions noise;
+  noise.enabled = false;
+  const RenderedScene out = Render(scene, noise);
+  const DepthImage depth = MakeDepthImage(out.cloud, out.camera);
+  const Eigen::Isometry3d& first = out.boxes.at(0).camera_T_box;
+  const Eigen::Isometry3d& second = out.boxes.at(1).camera_T_box;
+  auto runs_on_flat = [](const DeclinedCandidate& d) {
+    return d.reason.rfind("a side runs on flat", 0) == 0;
+  };
+  for (const int steps : {2, 1, 0}) {
+    DetectorOptions o;
+    o.box = kCartonS;
+    o.neighbour_steps_past_declined = steps;
+    // A corner's hypothesis: declined, no stepping stone.
+    {
+      internal::HypothesisJudge judge(depth, o);
+      judge.Propose(first, 0, {});
+      EXPECT_TRUE(judge.Evaluate(1).empty());
+      ASSERT_EQ(judge.declined().size(), 1u);
+      EXPECT_TRUE(runs_on_flat(judge.declined()[0])) << judge.declined()[0].reason;
+      EXPECT_TRUE(judge.TakeSteppingStones().empty());
+    }
+    internal::HypothesisJudge judge(depth, o);
+    judge.ProposeNeighbour(first);
+    EXPECT_TRUE(judge.Evaluate(1).empty());
+    ASSERT_EQ(judge.declined().size(), 1u);
+    EXPECT_TRUE(runs_on_flat(judge.declined()[0])) << judge.declined()[0].reason;
+    const auto stones = judge.TakeSteppingStones();
+    ASSERT_EQ(stones.size(), steps > 0 ? 1u : 0u) << steps;
+    EXPECT_TRUE(judge.TakeSteppingStones().empty());  // taken
+    if (steps == 0) continue;
+    EXPECT_EQ(stones[0].steps, 1);
+    EXPECT_EQ(stones[0].box.grasp_face, out.boxes.at(0).grasp_face);
+    EXPECT_LT((stones[0].box.camera_T_box.translation() - first.translation()).norm(), 0.01);
+    // The other carton, proposed past it: declined alike; a stepping stone
+    // two steps past only when two are allowed.
+    judge.ProposePastDeclined(second, stones[0].steps);
+    EXPECT_TRUE(judge.Evaluate(1).empty());
+    ASSERT_EQ(judge.declined().size(), 2u);
+    EXPECT_TRUE(runs_on_flat(judge.declined()[1])) << judge.declined()[1].reason;
+    const auto next = judge.TakeSteppingStones();
+    ASSERT_EQ(next.size(), steps >= 2 ? 1u : 0u) << steps;
+    if (steps >= 2) {
+      EXPECT_EQ(next[0].steps, 2);
+    }
+  }
+}
+
+// One row only (two cartons end to end, no gap, nothing beside them): the
+// hypothesis at either runs on flat with no seam anywhere, a face no
+// layer of touching boxes bounds (a bigger face, the floor), and is no
+// stepping stone.
+TEST(HypothesisJudgeTest, ANeighbourWithNoSeamIsNoSteppingStone) {
+  Scene scene;
+  scene.world_T_camera = LookAtCamera(Eigen::Vector3d::Zero(), 1.3, 10.0, 20.0, 0.0);
+  for (const double x : {-kCartonS.l / 2, kCartonS.l / 2}) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = Eigen::Vector3d(x, 0.0, kCartonS.h / 2.0);
+    scene.boxes.push_back({kCartonS, pose, true});
+  }
+  NoiseOptions noise;
+  noise.enabled = false;
+  const RenderedScene out = Render(scene, noise);
+  const DepthImage depth = MakeDepthImage(out.cloud, out.camera);
+  DetectorOptions o;
+  o.box = kCartonS;
+  internal::HypothesisJudge judge(depth, o);
+  judge.ProposeNeighbour(out.boxes.at(0).camera_T_box);
+  EXPECT_TRUE(judge.Evaluate(1).empty());
+  ASSERT_EQ(judge.declined().size(), 1u);
+  EXPECT_EQ(judge.declined()[0].reason.rfind("a side runs on flat", 0), 0u)
+      << judge.declined()[0].reason;
+  EXPECT_TRUE(judge.TakeSteppingStones().empty());
 }
 
 }  // namespace

@@ -110,11 +110,12 @@ TEST(LayerPlaneTest, ABoxAloneOrTurnedOffTheLayerKeepsItsOwnPlane) {
   const DetectedBox alone = one[0];
   EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &one), 0);
   EXPECT_TRUE(one[0].camera_T_box.isApprox(alone.camera_T_box));
-  // Three boxes of the layer and one tilted by 15 degrees: that one keeps
-  // its own plane, the others take the layer's.
+  // Three boxes of the layer and one returned tilted by 30 degrees: past
+  // adopt_angle_deg, that one keeps its own plane, the others take the
+  // layer's.
   std::vector<DetectedBox> boxes;
   for (size_t i = 0; i < 3; ++i) boxes.push_back(Returned(l.rendered.boxes[i], 2.0, 90.0 * i));
-  boxes.push_back(Returned(l.rendered.boxes[3], 15.0, 30.0));
+  boxes.push_back(Returned(l.rendered.boxes[3], 30.0, 30.0));
   const DetectedBox askew = boxes[3];
   EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 3);
   EXPECT_TRUE(boxes[3].camera_T_box.isApprox(askew.camera_T_box));
@@ -124,6 +125,50 @@ TEST(LayerPlaneTest, ABoxAloneOrTurnedOffTheLayerKeepsItsOwnPlane) {
   std::vector<DetectedBox> again = {Returned(l.rendered.boxes[0], 2.0, 0.0),
                                     Returned(l.rendered.boxes[1], 2.0, 90.0)};
   EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, off, &again), 0);
+}
+
+TEST(LayerPlaneTest, AFaceTiltedByItsFitAloneTakesTheLayersPlane) {
+  // Returned 15 degrees off (an active-stereo camera's correlated noise
+  // over a brick's narrow face) while its pixels lie on the layer: past
+  // max_angle_deg it joins no group, but it touches the group and its
+  // pixels fit the layer's plane, so it takes it (box 3 at the layer's
+  // side, box 5 at its corner).
+  const Layer l = RenderLayer();
+  for (const int tilted : {3, 5}) {
+    std::vector<DetectedBox> boxes;
+    for (int i = 0; i < 6; ++i) {
+      boxes.push_back(Returned(l.rendered.boxes[i], i == tilted ? 15.0 : 2.0, 60.0 * i));
+    }
+    EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 6) << tilted;
+    const Eigen::Vector3d n = TrueNormal(l.rendered.boxes[tilted]);
+    EXPECT_LT(Deg(std::acos(std::min(1.0, boxes[tilted].grasp_normal_camera.dot(n)))), 0.3)
+        << tilted;
+    // With adopt_angle_deg at max_angle_deg it keeps its own.
+    LayerPlaneOptions strict;
+    strict.adopt_angle_deg = strict.max_angle_deg;
+    std::vector<DetectedBox> again;
+    for (int i = 0; i < 6; ++i) {
+      again.push_back(Returned(l.rendered.boxes[i], i == tilted ? 15.0 : 2.0, 60.0 * i));
+    }
+    EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, strict, &again), 5) << tilted;
+  }
+}
+
+TEST(LayerPlaneTest, ABrickReallyTiltedBesideTheLayerKeepsItsPlane) {
+  // A brick beside the layer, turned 15 degrees about its long axis (one
+  // long side 2.3 cm higher than the other), its face centre on the
+  // layer's plane: its pixels do not fit that plane.
+  SceneBox askew = Flat(2 * kBrick.l, 0.0);
+  askew.world_T_box.linear() =
+      Eigen::AngleAxisd(15.0 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitX())
+          .toRotationMatrix();
+  const Layer l = RenderLayer({askew});
+  ASSERT_EQ(l.rendered.boxes.size(), 7u);
+  std::vector<DetectedBox> boxes;
+  for (int i = 0; i < 7; ++i) boxes.push_back(Returned(l.rendered.boxes[i], 0.0, 0.0));
+  const DetectedBox before = boxes[6];
+  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 6);
+  EXPECT_TRUE(boxes[6].camera_T_box.isApprox(before.camera_T_box));
 }
 
 TEST(LayerPlaneTest, ABoxOnTopOfTheLayerIsNotOnItsPlane) {
@@ -188,6 +233,9 @@ TEST(LayerPlaneTest, ValidateNamesTheField) {
   o = LayerPlaneOptions();
   o.plane_tolerance_m = 0.0;
   EXPECT_NE(o.Validate().message().find("layer_plane.plane_tolerance_m"), std::string::npos);
+  o = LayerPlaneOptions();
+  o.adopt_angle_deg = 50.0;
+  EXPECT_NE(o.Validate().message().find("layer_plane.adopt_angle_deg"), std::string::npos);
 }
 
 }  // namespace

@@ -48,6 +48,21 @@ absl::StatusOr<RenderedScene> KinectFrame(const std::string& kind, const BoxDims
   return Render(*scene, SensorOptions{});
 }
 
+// The frame's cloud with its depth rounded to millimetres, as the PNGs of
+// scripts/evaluate's sets hold it.
+PointCloud RoundedToMillimetres(const RenderedScene& r) {
+  PointCloud cloud = r.cloud;
+  for (int v = 0; v < cloud.height; ++v) {
+    for (int u = 0; u < cloud.width; ++u) {
+      Eigen::Vector3f& p = cloud.xyz[static_cast<size_t>(v) * cloud.width + u];
+      if (!PointCloud::IsValid(p)) continue;
+      const double z = std::round(p.z() * 1000.0) / 1000.0;
+      p = (z * PixelRay(r.camera, u, v)).cast<float>();
+    }
+  }
+  return cloud;
+}
+
 // Was: FindExtremities (common/perception/edge_segments.cc, the
 // `d1.dot(d2) < 0.0f` test) decides "all neighbours lie on the reference's
 // side" with full 3-D vectors. A point of a band that sits beside the
@@ -285,15 +300,7 @@ TEST(RegressionTest, NoTurnedBoxOnALowerLayerUnderAnUpperOne) {
     const absl::StatusOr<RenderedScene> frame = KinectFrame("touching2", carton_l, i, 4000 + i);
     ASSERT_TRUE(frame.ok()) << frame.status();
     const RenderedScene& r = *frame;
-    PointCloud cloud = r.cloud;
-    for (int v = 0; v < cloud.height; ++v) {
-      for (int u = 0; u < cloud.width; ++u) {
-        Eigen::Vector3f& p = cloud.xyz[static_cast<size_t>(v) * cloud.width + u];
-        if (!PointCloud::IsValid(p)) continue;
-        const double z = std::round(p.z() * 1000.0) / 1000.0;
-        p = (z * PixelRay(r.camera, u, v)).cast<float>();
-      }
-    }
+    const PointCloud cloud = RoundedToMillimetres(r);
     DetectorOptions options;
     options.box = carton_l;
     const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
@@ -391,6 +398,42 @@ TEST(RegressionTest, AHeapCartonAThirdUnderOthersIsNotTakenForSunk) {
   };
   EXPECT_TRUE(found(AcceptanceOptions{}.max_occluded));
   EXPECT_FALSE(found(0.3));
+}
+
+// Was: on a Kinect pallet of bricks, whose seams finer than a pixel show as
+// sparse lines of missing returns on some sides and not on others, the
+// chain of neighbours from the few bricks found stopped at the first brick
+// with a side that ran on flat: 3 of 50 pickable bricks found in frame 2 of
+// scripts/evaluate's kinect_brick_s22 set, 1 of 47 in frame 6, though the
+// judge accepts most of the rest from their true poses. A brick declined
+// only for a side that runs on flat now proposes its own neighbours, up to
+// two such bricks in a row (DetectorOptions::neighbour_steps_past_declined);
+// every brick returned is still one of the pallet's.
+TEST(RegressionTest, TheNeighbourChainGoesOnPastABrickWithASeamMissed) {
+  const BoxDims brick{0.19, 0.09, 0.057};
+  for (const int i : {2, 6}) {
+    const absl::StatusOr<RenderedScene> frame = KinectFrame("touching1", brick, i, 22000 + i);
+    ASSERT_TRUE(frame.ok()) << frame.status();
+    const RenderedScene& r = *frame;
+    const PointCloud cloud = RoundedToMillimetres(r);
+    for (const bool past : {true, false}) {
+      DetectorOptions options;
+      options.box = brick;
+      if (!past) options.neighbour_steps_past_declined = 0;
+      const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
+      ASSERT_TRUE(det.ok()) << det.status();
+      if (past) {
+        EXPECT_GE(det->boxes.size(), 20u) << "frame " << i;
+      } else {
+        EXPECT_LE(det->boxes.size(), 6u) << "frame " << i;
+      }
+      for (const DetectedBox& b : det->boxes) {
+        const PoseError nearest = AgainstNearest(b, r.boxes);
+        EXPECT_LT(nearest.translation_m, 0.02) << "frame " << i << " past " << past;
+        EXPECT_LT(nearest.rotation_deg, 10.0) << "frame " << i << " past " << past;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "common/perception/internal/hypothesis_judge.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 
@@ -12,6 +13,8 @@ namespace cornerpose::internal {
 namespace {
 
 constexpr char kMovedTooFar[] = "refinement moved it too far: not this box";
+constexpr char kRunsOnFlat[] =
+    "a side runs on flat with no seam (a bigger face, or a layer that does not tile uniquely)";
 
 }  // namespace
 
@@ -32,8 +35,7 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
   int measured = 0;
   for (SideKind k : ref.sides) {
     if (k == SideKind::kContinues) {
-      return "a side runs on flat with no seam (a bigger face, or a layer that does not "
-             "tile uniquely)";
+      return kRunsOnFlat;
     }
     measured += k == SideKind::kFree || k == SideKind::kSeam || k == SideKind::kTiled;
   }
@@ -136,6 +138,18 @@ void HypothesisJudge::Propose(const Eigen::Isometry3d& camera_T_box, int corners
   queue_.push_back({camera_T_box, corners, std::move(segments), from_face, retry});
 }
 
+void HypothesisJudge::ProposeNeighbour(const Eigen::Isometry3d& camera_T_box) {
+  const size_t queued = queue_.size();
+  Propose(camera_T_box, 0, {});
+  if (queue_.size() > queued) queue_.back().neighbour = true;
+}
+
+void HypothesisJudge::ProposePastDeclined(const Eigen::Isometry3d& camera_T_box, int steps) {
+  const size_t queued = queue_.size();
+  Propose(camera_T_box, 0, {});
+  if (queue_.size() > queued) queue_.back().past_declined = steps;
+}
+
 std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
   const int n = static_cast<int>(queue_.size());
   std::vector<Candidate> results(n);
@@ -153,6 +167,21 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
   for (int i = 0; i < n; ++i) {
     stats_.refined += refined[i];
     if (!accepted[i]) {
+      // A stepping stone: a neighbour (of a box accepted, or within the
+      // allowed steps past declined ones) declined for a side on flat, with
+      // a seam on another side (it lies in a layer of touching boxes; a
+      // face running on flat everywhere else is a bigger face or the floor,
+      // and stepping on from it only costs time).
+      const Proposal& q = queue_[i];
+      const std::array<SideKind, 4>& sides = results[i].refinement.sides;
+      const bool seamed = std::any_of(sides.begin(), sides.end(), [](SideKind k) {
+        return k == SideKind::kSeam || k == SideKind::kTiled;
+      });
+      if (refined[i] && reasons[i] == kRunsOnFlat && seamed &&
+          (q.neighbour || q.past_declined > 0) &&
+          q.past_declined < options_.neighbour_steps_past_declined) {
+        stepping_stones_.push_back({results[i].box, q.past_declined + 1});
+      }
       if (refined[i]) {
         declined_.push_back(
             {results[i].box.camera_T_box, results[i].box.score, std::move(reasons[i])});
@@ -205,6 +234,7 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   cand.box.score = first.support();  // what a declined candidate reports
   cand.refinement =
       RefineOnGraspFace(depth_, options_.box, grasp, options_.refinement, &cand.box.camera_T_box);
+  cand.box.grasp_face = grasp;  // what a stepping stone proposes from
   // The pose did not move (the gate saw it in front of the camera): the
   // full evidence would only confirm what JudgeRefined rejects it for.
   if (!cand.refinement.ok) {
@@ -228,6 +258,21 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
         PinnedOnEverySide(cand.refinement.sides))) {
     *reason = "grasp face cut by the image border";
     return false;
+  }
+  // Proposed past a declined neighbour (DetectorOptions::
+  // neighbour_steps_past_declined): refined again from its refined pose,
+  // it must still pass.
+  if (p.past_declined > 0) {
+    Eigen::Isometry3d again = cand.box.camera_T_box;
+    const RefinementResult second =
+        RefineOnGraspFace(depth_, options_.box, grasp, options_.refinement, &again);
+    std::string why = second.ok
+                          ? RefinementVerdict(second, options_.box, grasp, options_.acceptance)
+                          : std::string(kMovedTooFar);
+    if (!why.empty()) {
+      *reason = "refined once more from where it was refined, " + why;
+      return false;
+    }
   }
   cand.box.score = score;
   cand.box.measured_extent_m = {cand.refinement.extent_a_m, cand.refinement.extent_b_m};

@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/perception/box_evidence.h"
@@ -46,12 +47,30 @@ class HypothesisJudge {
   // declined is queued once more (with retry_declined).
   void Propose(const Eigen::Isometry3d& camera_T_box, int corners, std::vector<int> segments,
                bool from_face = false);
+  // Queues a neighbour of a box accepted: judged alike, and, declined only
+  // for a side that runs on flat, a stepping stone (TakeSteppingStones).
+  void ProposeNeighbour(const Eigen::Isometry3d& camera_T_box);
+  // Queues a neighbour of a stepping stone `steps` declined boxes past the
+  // last box accepted: judged alike, and once accepted refined again from
+  // its refined pose, where it must pass again; a stepping stone itself
+  // while steps < DetectorOptions::neighbour_steps_past_declined.
+  void ProposePastDeclined(const Eigen::Isometry3d& camera_T_box, int steps);
 
   // Evaluates the queue on up to `threads` threads; returns the accepted
   // candidates in the order they were proposed, and empties the queue.
   // Hypotheses that got as far as refinement and failed are kept, with the
   // reason, in declined().
   std::vector<Candidate> Evaluate(int threads);
+
+  // A neighbour declined only because a side of its face runs on flat:
+  // what it would have proposed as neighbours is still worth judging.
+  struct SteppingStone {
+    DetectedBox box;  // the refined pose, its grasp face set
+    int steps = 1;    // declined boxes past the last accepted, itself included
+  };
+  // The stepping stones among the hypotheses evaluated since the last call
+  // (DetectorOptions::neighbour_steps_past_declined).
+  std::vector<SteppingStone> TakeSteppingStones() { return std::exchange(stepping_stones_, {}); }
 
   const HypothesisStats& stats() const { return stats_; }
   const std::vector<DeclinedCandidate>& declined() const { return declined_; }
@@ -62,7 +81,10 @@ class HypothesisJudge {
     int corners;
     std::vector<int> segments;
     bool from_face;
-    bool retry = false;  // a second start at a pose declined once
+    bool retry = false;      // a second start at a pose declined once
+    bool neighbour = false;  // proposed by a box accepted
+    int past_declined = 0;   // proposed by a stepping stone this many declined boxes past
+                             // the last accepted (0: not)
   };
   // Evaluates one proposal; false when rejected. `refined` is set when it
   // got as far as refinement; then `reason` says why it was rejected, and
@@ -92,6 +114,7 @@ class HypothesisJudge {
   std::vector<Proposal> queue_;
   HypothesisStats stats_;
   std::vector<DeclinedCandidate> declined_;
+  std::vector<SteppingStone> stepping_stones_;
 };
 
 }  // namespace cornerpose::internal
