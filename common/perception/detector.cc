@@ -524,7 +524,7 @@ class BoxAcceptance {
           for (const Eigen::Isometry3d& pose :
                NeighbourHypotheses(c.box, options_.box, options_.neighbour_gap_m,
                                    options_.neighbours_a_layer_down)) {
-            judge_->ProposeNeighbour(pose);
+            judge_->ProposeNeighbour(pose, c.chained);
           }
         }
       }

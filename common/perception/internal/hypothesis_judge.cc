@@ -138,10 +138,13 @@ void HypothesisJudge::Propose(const Eigen::Isometry3d& camera_T_box, int corners
   queue_.push_back({camera_T_box, corners, std::move(segments), from_face, retry});
 }
 
-void HypothesisJudge::ProposeNeighbour(const Eigen::Isometry3d& camera_T_box) {
+void HypothesisJudge::ProposeNeighbour(const Eigen::Isometry3d& camera_T_box, bool chained) {
   const size_t queued = queue_.size();
   Propose(camera_T_box, 0, {});
-  if (queue_.size() > queued) queue_.back().neighbour = true;
+  if (queue_.size() > queued) {
+    queue_.back().neighbour = true;
+    queue_.back().chained = chained;
+  }
 }
 
 void HypothesisJudge::ProposePastDeclined(const Eigen::Isometry3d& camera_T_box, int steps) {
@@ -262,7 +265,8 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   // Proposed past a declined neighbour (DetectorOptions::
   // neighbour_steps_past_declined): refined again from its refined pose,
   // it must still pass.
-  if (p.past_declined > 0) {
+  cand.chained = p.past_declined > 0 || p.chained;
+  if (cand.chained) {
     Eigen::Isometry3d again = cand.box.camera_T_box;
     const RefinementResult second =
         RefineOnGraspFace(depth_, options_.box, grasp, options_.refinement, &again);

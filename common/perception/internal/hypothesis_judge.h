@@ -22,6 +22,9 @@ struct Candidate {
   DetectedBox box;
   BoxEvidence evidence;
   RefinementResult refinement;
+  // Reached through a stepping stone (proposed by one, or by a box so
+  // reached): its own neighbours are checked as strictly.
+  bool chained = false;
 };
 
 // The part of the acceptance test the refinement alone decides (the face's
@@ -49,7 +52,7 @@ class HypothesisJudge {
                bool from_face = false);
   // Queues a neighbour of a box accepted: judged alike, and, declined only
   // for a side that runs on flat, a stepping stone (TakeSteppingStones).
-  void ProposeNeighbour(const Eigen::Isometry3d& camera_T_box);
+  void ProposeNeighbour(const Eigen::Isometry3d& camera_T_box, bool chained = false);
   // Queues a neighbour of a stepping stone `steps` declined boxes past the
   // last box accepted: judged alike, and once accepted refined again from
   // its refined pose, where it must pass again; a stepping stone itself
@@ -83,6 +86,7 @@ class HypothesisJudge {
     bool from_face;
     bool retry = false;      // a second start at a pose declined once
     bool neighbour = false;  // proposed by a box accepted
+    bool chained = false;    // ... one reached through a stepping stone
     int past_declined = 0;   // proposed by a stepping stone this many declined boxes past
                              // the last accepted (0: not)
   };
