@@ -132,8 +132,9 @@ struct DetectorOptions {
   // boxes beyond it show theirs. A declined box is never returned; what it proposes is judged like
   // any hypothesis and, once accepted, refined again from its refined pose, where it must pass the
   // refinement's part of the test once more (a brick's length across the seam between two bricks,
-  // accepted from a lucky start, moves off there and finds a side running on flat). Count, [0, 4];
-  // 0: the chain stops at the first box declined.
+  // accepted from a lucky start, moves off there and finds a side running on flat); so must the
+  // neighbours of a box so reached, and theirs. Count, [0, 4]; 0: the chain stops at the first
+  // box declined.
   int neighbour_steps_past_declined = 2;
   // Unorganized clouds are projected through `camera` onto its pixel grid
   // (the nearest point per pixel) and processed like a frame. Right for a
