@@ -235,6 +235,16 @@ OpenNi2Source::SessionEnd OpenNi2Source::Capture(std::string* reason) {
   // 1..count); the frame timeout is the fallback when the count is unknown.
   const int frame_count = playback != nullptr ? playback->getNumberOfFrames(depth) : 0;
   const bool play_once = file && !options_.loop;
+  // A recording played once whose length is known is played by OpenNI2 in
+  // a loop all the same, and the session ends at its last frame (or the
+  // first frame of the next pass, when the last was skipped): once OpenNI2's
+  // file player reaches the end of a recording it does not repeat, its
+  // thread idles walking its list of streams unlocked, and tearing the
+  // stream down under it crashed the process (libOniFile, one run in about
+  // 30 on a loaded machine). Playing on, it waits in manual mode at
+  // teardown, as for a recording played in a loop.
+  if (play_once && frame_count > 0) playback->setRepeatEnabled(true);
+  int last_index = 0;
 
   absl::Time last_frame = absl::Now();
   bool any_frame = false;
@@ -258,11 +268,14 @@ OpenNi2Source::SessionEnd OpenNi2Source::Capture(std::string* reason) {
       *reason = std::string(frame.status().message());
       return SessionEnd::kFailed;
     }
+    // The next pass began (the last frame was skipped): the recording is
+    // over, and this frame was already delivered in the first pass.
+    const int index = ref.getFrameIndex();
+    if (play_once && frame_count > 0 && index < last_index) return SessionEnd::kFinished;
+    last_index = index;
     frame->device_timestamp_us = ref.getTimestamp();
     Publish(*std::move(frame));
-    if (play_once && frame_count > 0 && ref.getFrameIndex() >= frame_count) {
-      return SessionEnd::kFinished;
-    }
+    if (play_once && frame_count > 0 && index >= frame_count) return SessionEnd::kFinished;
   }
   return SessionEnd::kStopping;
 }
