@@ -51,7 +51,10 @@ class HypothesisJudge {
   void Propose(const Eigen::Isometry3d& camera_T_box, int corners, std::vector<int> segments,
                bool from_face = false);
   // Queues a neighbour of a box accepted: judged alike, and, declined only
-  // for a side that runs on flat, a stepping stone (TakeSteppingStones).
+  // for a side that runs on flat with a seam on another, a stepping stone
+  // (TakeSteppingStones). `chained`: the box proposing it was reached
+  // through a stepping stone (Candidate::chained), and this one, once
+  // accepted, must pass again from its refined pose too.
   void ProposeNeighbour(const Eigen::Isometry3d& camera_T_box, bool chained = false);
   // Queues a neighbour of a stepping stone `steps` declined boxes past the
   // last box accepted: judged alike, and once accepted refined again from
@@ -65,8 +68,9 @@ class HypothesisJudge {
   // reason, in declined().
   std::vector<Candidate> Evaluate(int threads);
 
-  // A neighbour declined only because a side of its face runs on flat:
-  // what it would have proposed as neighbours is still worth judging.
+  // A neighbour declined only because a side of its face runs on flat,
+  // with a seam on another side: what it would have proposed as
+  // neighbours is still worth judging.
   struct SteppingStone {
     DetectedBox box;  // the refined pose, its grasp face set
     int steps = 1;    // declined boxes past the last accepted, itself included
