@@ -90,6 +90,9 @@ constexpr char kHelp[] =
     "  --past_declined N    a neighbour declined only for a side that runs on flat\n"
     "                       still proposes its own, up to N declined in a row (2;\n"
     "                       0: the chain of neighbours stops at the first)\n"
+    "  --end_on_flat M      a hypothesis whose first refinement step finds a side\n"
+    "                       running on flat and no seam, moving it less than M, ends\n"
+    "                       there (declined; 0.003; 0: every step)\n"
     "  --rim_sides BOOL     a side where the face runs on but ends within 2 cm is free\n"
     "                       there, when it is the face's only side in doubt (true)\n"
     "  --anchored_faces BOOL a planar patch that does not tile (an L of box tops, a\n"
@@ -147,6 +150,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("border_faces", &options.faces.propose_at_border),
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
+        args.SetDouble("end_on_flat", &options.refinement.end_on_flat_shift_m),
         args.SetBool("layer_down", &options.neighbours_a_layer_down),
         args.SetInt("past_declined", &options.neighbour_steps_past_declined),
         args.SetDouble("seam_outward", &options.refinement.seam_search_outward_m),
@@ -254,6 +258,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "border_faces",
                                                        "anchored_faces",
                                                        "rim_sides",
+                                                       "end_on_flat",
                                                        "layer_down",
                                                        "past_declined",
                                                        "seam_outward",

@@ -137,26 +137,31 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
       skip1 -= 1.0;
     }
     double sa = 0, sb = 0, sn = 0, saa = 0, sab = 0, san = 0, sbb = 0, sbn = 0, snn = 0;
-    for (int u = ua; u <= ub; ++u) {
+    // The ray-plane grid near the sides (pixels outside (skip0, skip1)).
+    auto grid = [&](int u) {
       const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row, n_r = n_x[u - ua] + n_row;
-      const float z = zrow[u];
-      if ((u <= skip0 || u >= skip1) && std::abs(n_r) > 1e-6) {
-        const double t = n_c / n_r;
-        const double qa = t * a_r - a_c, qb = t * b_r - b_c;
-        if (std::abs(qa) <= lim_a && std::abs(qb) <= lim_b &&
-            (std::abs(qa) > in_a || std::abs(qb) > in_b)) {
-          const bool hit = !std::isnan(z) && std::abs(z * n_r - n_c) <= plane_tol;
-          to_sides(FacePoint{qa, qb, hit ? 1.0 : 0.0}, out.grid);
-        }
+      if (std::abs(n_r) <= 1e-6) return;
+      const double t = n_c / n_r;
+      const double qa = t * a_r - a_c, qb = t * b_r - b_c;
+      if (std::abs(qa) <= lim_a && std::abs(qb) <= lim_b &&
+          (std::abs(qa) > in_a || std::abs(qb) > in_b)) {
+        const float z = zrow[u];
+        const bool hit = !std::isnan(z) && std::abs(z * n_r - n_c) <= plane_tol;
+        to_sides(FacePoint{qa, qb, hit ? 1.0 : 0.0}, out.grid);
       }
-      if (std::isnan(z)) continue;
+    };
+    // The measured point, every pixel.
+    auto measured = [&](int u) {
+      const float z = zrow[u];
+      if (std::isnan(z)) return;
+      const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row, n_r = n_x[u - ua] + n_row;
       const FacePoint q{z * a_r - a_c, z * b_r - b_c, z * n_r - n_c};
-      if (std::abs(q.a) > lim_a || std::abs(q.b) > lim_b) continue;
+      if (std::abs(q.a) > lim_a || std::abs(q.b) > lim_b) return;
       if (q.n > plane_tol) {
         to_sides(q, out.front);
-        continue;
+        return;
       }
-      if (q.n < -plane_tol) continue;
+      if (q.n < -plane_tol) return;
       if (!(std::abs(q.a) > inside_a || std::abs(q.b) > inside_b)) {
         ++out.interior;
         sa += q.a;
@@ -170,6 +175,23 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
         snn += q.n * q.n;
       }
       to_sides(q, out.on_plane);
+    };
+    // Three runs of the row, in order (each list keeps pixel order): with
+    // the grid, without it (the pixels strictly inside (skip0, skip1)),
+    // with it. The split only keeps the middle run's loop small.
+    const int mid0 = static_cast<int>(std::floor(std::clamp(skip0, ua - 1.0, ub + 1.0))) + 1;
+    const int mid1 = static_cast<int>(std::ceil(std::clamp(skip1, ua - 1.0, ub + 1.0))) - 1;
+    const int left_end = mid0 <= mid1 ? std::min(ub, mid0 - 1) : ub;
+    for (int u = ua; u <= left_end; ++u) {
+      grid(u);
+      measured(u);
+    }
+    if (mid0 <= mid1) {
+      for (int u = std::max(ua, mid0); u <= std::min(ub, mid1); ++u) measured(u);
+      for (int u = std::max(ua, mid1 + 1); u <= ub; ++u) {
+        grid(u);
+        measured(u);
+      }
     }
     out.sum += Eigen::Vector3d(sa, sb, sn);
     out.sum_outer += (Eigen::Matrix3d() << saa, sab, san, sab, sbb, sbn, san, sbn, snn).finished();
@@ -831,6 +853,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.max_tile_march_m", max_tile_march_m, 0.0, 100.0),
            CheckRange("refinement.rim_extent_tolerance_m", rim_extent_tolerance_m, 0.0, 0.1),
            CheckRange("refinement.iterations", iterations, 0, 20),
+           CheckRange("refinement.end_on_flat_shift_m", end_on_flat_shift_m, 0.0, 0.05),
            CheckPositive("refinement.max_shift_m", max_shift_m),
            CheckPositive("refinement.max_turn_deg", max_turn_deg),
        }) {
@@ -1052,6 +1075,24 @@ void TileContinuingSides(const DepthImage& depth, const BoxDims& dims, BoxFace g
   }
 }
 
+// After the first step: a side runs on flat, no side shows a seam (so no
+// tiling can make it a tile: TileContinuingSides), and the step moved the
+// pose less than end_on_flat_shift_m, so the second step reads the same
+// bands and the hypothesis is declined for the side on flat (two thirds of
+// all refined hypotheses are). One the step moved further may read its
+// sides differently from where it lands.
+bool EndsOnFlat(const RefinementResult& result, const RefinementOptions& options,
+                const Eigen::Isometry3d& pose, const Eigen::Isometry3d& initial) {
+  if (options.end_on_flat_shift_m <= 0.0 || options.tile_uncued_sides) return false;
+  bool continues = false;
+  for (SideKind k : result.sides) {
+    if (k == SideKind::kSeam) return false;
+    continues |= k == SideKind::kContinues;
+  }
+  return continues &&
+         (pose.translation() - initial.translation()).norm() < options.end_on_flat_shift_m;
+}
+
 }  // namespace
 
 RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face,
@@ -1062,6 +1103,11 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
   Eigen::Isometry3d pose = initial;
   for (int it = 0; it < std::max(1, options.iterations); ++it) {
     if (!RefineStep(depth, dims, grasp_face, options, pose, result)) return result;
+    if (it == 0 && options.iterations > 1 && EndsOnFlat(result, options, pose, initial)) {
+      *camera_T_box = pose;
+      result.ok = true;  // read, and declined for the side on flat
+      return result;
+    }
   }
   // A reading that moved too far is not this box: its sides are not worth
   // the shadow and tiling checks (a third of all refinements end here).

@@ -91,6 +91,12 @@ struct RefinementOptions {
   double rim_extent_tolerance_m = 0.015;
   // Iterations of measure-and-update. Count.
   int iterations = 2;
+  // A hypothesis whose first iteration finds a side running on flat and no
+  // seam on any side, having moved it less than this, ends there: the next
+  // iteration would read the same bands, and it is declined for that side
+  // (RefineOnGraspFace then returns ok with the first iteration's sides and
+  // pose). 0 runs every iteration. Metres.
+  double end_on_flat_shift_m = 0.003;
   // Largest correction accepted, beyond which the hypothesis is not this
   // box: metres and degrees.
   double max_shift_m = 0.05;

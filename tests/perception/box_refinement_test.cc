@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -257,6 +258,49 @@ TEST(RefineOnGraspFaceTest, AReadingOnPartOfABiggerFaceRunsOn) {
   int runs_on = 0;
   for (SideKind k : r.sides) runs_on += k == SideKind::kContinues;
   EXPECT_EQ(runs_on, 1);
+}
+
+// The same reading, refined as the detector does: its first step already
+// shows the side running on flat, with no seam anywhere, having barely
+// moved it, so the refinement ends there (what a second step would read is
+// the same side on flat). Started 1 cm off across the face, the first step
+// moves it back by that much and every step runs.
+TEST(RefineOnGraspFaceTest, AReadingOnABiggerFaceEndsAfterItsFirstStep) {
+  const BoxDims long_box{2 * kCartonS.l, kCartonS.b, kCartonS.h};
+  const FlatScene s = RenderFlat({Flat(long_box, 0.0, 0.0)});
+  const GroundTruthBox& gt = s.rendered.boxes[0];
+  RefinementOptions one_step, every_step;
+  one_step.iterations = 1;
+  every_step.end_on_flat_shift_m = 0.0;
+  auto refine = [&](double across, const RefinementOptions& o) {
+    Eigen::Isometry3d pose = Moved(gt.camera_T_box, -kCartonS.l / 2.0, across, 0.0);
+    const RefinementResult r = RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), o, &pose);
+    EXPECT_TRUE(r.ok);
+    return std::pair{r, pose};
+  };
+  const auto [ended, ended_pose] = refine(0.0, RefinementOptions{});
+  const auto [first, first_pose] = refine(0.0, one_step);
+  EXPECT_EQ(ended.sides, first.sides);
+  EXPECT_TRUE(ended_pose.isApprox(first_pose, 0.0)) << "the first step's pose, bit for bit";
+  EXPECT_EQ(std::count(ended.sides.begin(), ended.sides.end(), SideKind::kContinues), 1);
+  const auto [full, full_pose] = refine(0.0, every_step);
+  EXPECT_EQ(full.sides, ended.sides) << "a second step reads the same";
+  EXPECT_FALSE(full_pose.isApprox(first_pose, 0.0)) << "... from a pose a little moved";
+
+  const auto [slid, slid_pose] = refine(0.01, RefinementOptions{});
+  const auto [slid_full, slid_full_pose] = refine(0.01, every_step);
+  EXPECT_EQ(slid.sides, slid_full.sides);
+  EXPECT_TRUE(slid_pose.isApprox(slid_full_pose, 0.0)) << "moved 1 cm: every step ran";
+  EXPECT_FALSE(slid_pose.isApprox(refine(0.01, one_step).second, 1e-12));
+}
+
+TEST(RefinementOptionsTest, ValidateNamesTheEndOnFlatShift) {
+  RefinementOptions o;
+  EXPECT_TRUE(o.Validate().ok());
+  o.end_on_flat_shift_m = -0.001;
+  EXPECT_NE(o.Validate().message().find("end_on_flat_shift_m"), std::string::npos);
+  o.end_on_flat_shift_m = 0.0;
+  EXPECT_TRUE(o.Validate().ok()) << "0: every step";
 }
 
 // A carton of the layer under another that stands on it right at the

@@ -119,7 +119,13 @@ bool PinnedOnEverySide(const std::array<SideKind, 4>& sides) {
 
 HypothesisJudge::HypothesisJudge(const DepthImage& depth, const DetectorOptions& options,
                                  const CancelToken* cancel)
-    : depth_(depth), options_(options), symmetries_(BoxSymmetries(options.box)), cancel_(cancel) {}
+    : depth_(depth),
+      options_(options),
+      neighbour_refinement_(options.refinement),
+      symmetries_(BoxSymmetries(options.box)),
+      cancel_(cancel) {
+  neighbour_refinement_.end_on_flat_shift_m = 0.0;
+}
 
 void HypothesisJudge::Propose(const Eigen::Isometry3d& camera_T_box, int corners,
                               std::vector<int> segments, bool from_face) {
@@ -235,8 +241,12 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   }
   *refined = true;
   cand.box.score = first.support();  // what a declined candidate reports
-  cand.refinement =
-      RefineOnGraspFace(depth_, options_.box, grasp, options_.refinement, &cand.box.camera_T_box);
+  // A neighbour of a box found may be a stepping stone: its seam may show
+  // only in the refinement's second iteration, so it gets every iteration.
+  const bool from_the_frame = !p.neighbour && !p.chained && p.past_declined == 0;
+  cand.refinement = RefineOnGraspFace(depth_, options_.box, grasp,
+                                      from_the_frame ? options_.refinement : neighbour_refinement_,
+                                      &cand.box.camera_T_box);
   cand.box.grasp_face = grasp;  // what a stepping stone proposes from
   // The pose did not move (the gate saw it in front of the camera): the
   // full evidence would only confirm what JudgeRefined rejects it for.

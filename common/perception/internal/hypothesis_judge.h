@@ -113,6 +113,8 @@ class HypothesisJudge {
 
   const DepthImage& depth_;
   const DetectorOptions& options_;
+  // options_.refinement for the neighbours of boxes found: every iteration.
+  RefinementOptions neighbour_refinement_;
   const std::vector<Eigen::Matrix3d> symmetries_;
   const CancelToken* const cancel_;
   std::vector<Eigen::Isometry3d> seen_;
