@@ -61,6 +61,9 @@ constexpr char kHelp[] =
     "                       of its tiles (true)\n"
     "  --floor_check BOOL   no box reaches through the floor, the farthest large plane\n"
     "                       (true)\n"
+    "  --level_check M      a box whose top is level with a box beside it but whose\n"
+    "                       bottom would lie more than M below that one's is taken\n"
+    "                       out (0.05; 0: off)\n"
     "  --layer_plane DEG    boxes side by side on one plane (a layer) take the plane\n"
     "                       fitted through all their faces when within DEG of it (12;\n"
     "                       0: every box keeps its own face's plane)\n"
@@ -139,6 +142,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("faces", &options.face_proposals),
         args.SetBool("layer_check", &options.faces.check_layer_tiling),
         args.SetBool("floor_check", &options.floor_check),
+        args.SetDouble("level_check", &options.max_below_neighbours_m),
         args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
         args.SetDouble("layer_adopt", &options.layer_plane.adopt_angle_deg),
         args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
@@ -245,6 +249,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "faces",
                                                        "layer_check",
                                                        "floor_check",
+                                                       "level_check",
                                                        "layer_plane",
                                                        "layer_adopt",
                                                        "seam_colour",

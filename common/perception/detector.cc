@@ -138,6 +138,51 @@ bool CheckFloor(const DepthImage& depth, const DetectorOptions& options, const F
   });
 }
 
+// A box stands on something: amid the boxes of a layer found around it,
+// their tops level with its own (DetectorOptions::max_below_neighbours_m),
+// its bottom cannot lie far below theirs, in a hole of what they stand on.
+// It takes two such neighbours, a layer: beside one box lying on another in
+// a heap, a box on end stands as level with it. True when a box was taken
+// out.
+bool CheckStandsLevel(const DetectorOptions& options, std::vector<DetectedBox>* boxes,
+                      std::vector<std::array<SideKind, 4>>* sides,
+                      std::vector<DeclinedCandidate>* declined) {
+  constexpr int kLayerNeighbours = 2;
+  const BoxDims& d = options.box;
+  const double tol = options.max_below_neighbours_m;
+  const std::vector<DetectedBox> all = *boxes;  // each judged against all
+  auto height = [&](const DetectedBox& b) { return d[static_cast<int>(b.grasp_face) / 2]; };
+  auto half_diagonal = [&](const DetectedBox& b) {
+    const int n = static_cast<int>(b.grasp_face) / 2;
+    return 0.5 * std::hypot(d[(n + 1) % 3], d[(n + 2) % 3]);
+  };
+  const double cos_parallel = std::cos(12.0 * M_PI / 180.0);
+  return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
+    const DetectedBox& b = (*boxes)[i];
+    int level = 0;
+    double deepest = 0.0;
+    for (size_t j = 0; j < all.size(); ++j) {
+      if (j == i) continue;
+      const DetectedBox& nb = all[j];
+      const Eigen::Vector3d& n = nb.grasp_normal_camera;  // toward the camera
+      if (b.grasp_normal_camera.dot(n) < cos_parallel) continue;
+      const Eigen::Vector3d offset = b.grasp_centre_camera - nb.grasp_centre_camera;
+      const double above = offset.dot(n);  // b's top above its neighbour's
+      const double apart = (offset - above * n).norm();
+      if (std::abs(above) > tol || apart > 1.15 * (half_diagonal(b) + half_diagonal(nb))) continue;
+      const double below = height(b) - above - height(nb);  // b's bottom below nb's
+      if (below <= tol) continue;
+      ++level;
+      deepest = std::max(deepest, below);
+    }
+    if (level < kLayerNeighbours) return "";
+    return absl::StrFormat(
+        "its top is level with %d boxes around it but its bottom would lie %.0f mm below theirs, "
+        "in a hole: a box of another size?",
+        level, 1000.0 * deepest);
+  });
+}
+
 // The layer check (FaceProposalOptions::check_layer_tiling). A layer is
 // trusted when a box ended by depth jumps on both axes of its face (a free
 // side along each) is one of its tiles; on a trusted layer, a box that a
@@ -268,6 +313,10 @@ absl::Status DetectorOptions::Validate() const {
   if (!(floor_tolerance_m > 0.0 && floor_tolerance_m <= 0.5)) {
     return absl::InvalidArgumentError(
         absl::StrCat("floor_tolerance_m=", floor_tolerance_m, " is outside (0, 0.5]"));
+  }
+  if (!(max_below_neighbours_m >= 0.0 && max_below_neighbours_m <= 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_below_neighbours_m=", max_below_neighbours_m, " is outside [0, 1]"));
   }
   if (!(floor_min_area_m2 > 0.0 && floor_min_area_m2 <= 100.0)) {
     return absl::InvalidArgumentError(
@@ -577,7 +626,10 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
     const bool layer_removed =
         options.faces.check_layer_tiling &&
         CheckLayers(f.depth, options, faces, &det->boxes, acceptance->sides_of(), declined);
-    return floor_removed || layer_removed;
+    const bool level_removed =
+        options.max_below_neighbours_m > 0.0 &&
+        CheckStandsLevel(options, &det->boxes, acceptance->sides_of(), declined);
+    return floor_removed || layer_removed || level_removed;
   };
   for (int round = 0; round < 3 && check(); ++round) {
     for (const LayerTiles& layer : faces.layers) {

@@ -87,6 +87,14 @@ struct DetectorOptions {
   LayerPlaneOptions layer_plane;
   double floor_tolerance_m = 0.03;
   double floor_min_area_m2 = 0.25;
+  // With face proposals: a box whose top lies level (within this) with two
+  // or more boxes found beside it (grasp faces parallel and touching: a
+  // layer around it) but whose bottom would lie more than this below
+  // theirs is taken out: it would stand in a hole in what they stand on.
+  // What it is: a box of another size whose top matches one of the box's
+  // faces (a smaller box in a layer of flat cartons read as a carton on
+  // end). 0 turns the check off. Metres.
+  double max_below_neighbours_m = 0.05;
   // How far a real box may be off its nominal size (bulge, sag, crushed
   // corners) and still be the box. Unset keeps each stage's own tolerance
   // (pose.length_tolerance_m 0.025, acceptance.extent_tolerance_m 0.025,

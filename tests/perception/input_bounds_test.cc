@@ -80,6 +80,17 @@ TEST(InputBoundsTest, IntrinsicsOutsidePlausibleRangesNameFieldValueAndRange) {
   EXPECT_TRUE(k.Validate().ok()) << k.Validate();
 }
 
+TEST(InputBoundsTest, DetectorOptionsNameTheLevelCheckOutOfRange) {
+  DetectorOptions options;
+  options.box = BoxDims{0.30, 0.20, 0.15};
+  EXPECT_TRUE(options.Validate().ok());
+  options.max_below_neighbours_m = -0.01;
+  EXPECT_THAT(std::string(options.Validate().message()),
+              HasSubstr("max_below_neighbours_m=-0.01 is outside [0, 1]"));
+  options.max_below_neighbours_m = 0.0;
+  EXPECT_TRUE(options.Validate().ok()) << "0 turns the check off";
+}
+
 TEST(InputBoundsTest, DetectorRejectsAnAbsurdCameraWithItsField) {
   DetectorOptions options;
   options.box = BoxDims{0.3, 0.2, 0.15};
