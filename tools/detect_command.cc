@@ -93,6 +93,8 @@ constexpr char kHelp[] =
     "  --past_declined N    a neighbour declined only for a side that runs on flat\n"
     "                       still proposes its own, up to N declined in a row (2;\n"
     "                       0: the chain of neighbours stops at the first)\n"
+    "  --seam_turn M        a seam along a side at least M long turns the face as a\n"
+    "                       free side does (0.1; 0: seams give a position only)\n"
     "  --end_on_flat M      a hypothesis whose first refinement step finds a side\n"
     "                       running on flat and no seam, moving it less than M, ends\n"
     "                       there (declined; 0.003; 0: every step)\n"
@@ -155,6 +157,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
         args.SetDouble("end_on_flat", &options.refinement.end_on_flat_shift_m),
+        args.SetDouble("seam_turn", &options.refinement.seam_turn_min_length_m),
         args.SetBool("layer_down", &options.neighbours_a_layer_down),
         args.SetInt("past_declined", &options.neighbour_steps_past_declined),
         args.SetDouble("seam_outward", &options.refinement.seam_search_outward_m),
@@ -264,6 +267,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "anchored_faces",
                                                        "rim_sides",
                                                        "end_on_flat",
+                                                       "seam_turn",
                                                        "layer_down",
                                                        "past_declined",
                                                        "seam_outward",

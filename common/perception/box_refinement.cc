@@ -211,6 +211,8 @@ struct SideMeasure {
   // kContinues only: where the face's points end within the band.
   bool rim = false;
   double rim_position = 0.0, rim_slope = 0.0;
+  // kSeam only: the seam's turn, from where each half of the side has it.
+  std::optional<double> seam_slope;
   bool measured() const { return kind == SideKind::kFree || kind == SideKind::kSeam; }
 };
 
@@ -447,7 +449,7 @@ class SeamScan {
 std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
                                const std::vector<FacePoint>& grid, bool along_a, double sign,
                                double half, double half_other, double pixel_m,
-                               const RefinementOptions& o) {
+                               const RefinementOptions& o, std::optional<double>* slope) {
   constexpr double kAll = std::numeric_limits<double>::infinity();
   const SeamScan whole(pts, grid, along_a, sign, half, half_other, pixel_m, o);
   if (whole.points() < 50 || whole.expected() < 50) return std::nullopt;
@@ -480,6 +482,30 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
       }
       if (std::isfinite(strongest) && strongest <= o.seam_halves_min_strength) return std::nullopt;
     }
+  }
+  // Where each half of the side has its seam (searched 4 mm either way of
+  // the whole side's, every half millimetre): the seam's turn.
+  const double reach = half_other - o.side_band_m;  // the side's stretch, either way
+  if (slope != nullptr && o.seam_turn_min_length_m > 0.0 &&
+      2.0 * reach >= o.seam_turn_min_length_m) {
+    double at[2];
+    bool found = true;
+    int k = 0;
+    for (const auto& [lo, hi] : {std::pair{-kAll, 0.0}, std::pair{0.0, kAll}}) {
+      const SeamScan part = whole.Stretch(lo, hi);
+      double strongest = 0.0;
+      std::optional<double> pos;
+      for (double c = *best - 0.004; c <= *best + 0.004 + 1e-9; c += 0.0005) {
+        const std::optional<double> st = part.Strength(c);
+        if (st && *st > strongest) {
+          strongest = *st;
+          pos = c;
+        }
+      }
+      if (!pos) found = false;
+      at[k++] = pos.value_or(0.0);
+    }
+    if (found) *slope = (at[1] - at[0]) / reach;  // half centres reach/2 either side
   }
   return half + *best;
 }
@@ -549,7 +575,7 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
     // The face continues past the side: a seam to a touching box, or the
     // hypothesis is too small for this face.
     if (std::optional<double> seam =
-            FindSeam(pts, grid, along_a, sign, half, half_other, pixel_m, o)) {
+            FindSeam(pts, grid, along_a, sign, half, half_other, pixel_m, o, &m.seam_slope)) {
       m.kind = SideKind::kSeam;
       m.position = *seam;
       m.outward_seam = *seam - half > o.seam_search_m - 0.0015;
@@ -854,6 +880,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.rim_extent_tolerance_m", rim_extent_tolerance_m, 0.0, 0.1),
            CheckRange("refinement.iterations", iterations, 0, 20),
            CheckRange("refinement.end_on_flat_shift_m", end_on_flat_shift_m, 0.0, 0.05),
+           CheckRange("refinement.seam_turn_min_length_m", seam_turn_min_length_m, 0.0, 10.0),
            CheckPositive("refinement.max_shift_m", max_shift_m),
            CheckPositive("refinement.max_turn_deg", max_turn_deg),
        }) {
@@ -938,6 +965,11 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
   if (ma.kind == SideKind::kFree) turns.push_back(ma.slope);
   if (pb.kind == SideKind::kFree) turns.push_back(pb.slope);
   if (mb.kind == SideKind::kFree) turns.push_back(-mb.slope);
+  // Seams turn the face too (RefinementOptions::seam_turn_min_length_m).
+  if (pa.kind == SideKind::kSeam && pa.seam_slope) turns.push_back(-*pa.seam_slope);
+  if (ma.kind == SideKind::kSeam && ma.seam_slope) turns.push_back(*ma.seam_slope);
+  if (pb.kind == SideKind::kSeam && pb.seam_slope) turns.push_back(*pb.seam_slope);
+  if (mb.kind == SideKind::kSeam && mb.seam_slope) turns.push_back(-*mb.seam_slope);
   double turn = 0.0;
   if (!turns.empty()) turn = std::atan(Median(turns));
 

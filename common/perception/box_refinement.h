@@ -89,6 +89,12 @@ struct RefinementOptions {
   // from this short to twice this long, along it within this (where both
   // its sides are free). Metres.
   double rim_extent_tolerance_m = 0.015;
+  // A seam found along a side whose stretch (its length less a band at
+  // each end) is at least this long turns the face as a free side does:
+  // by where each half of the side has the seam. Seams along shorter
+  // sides give a position only (a millimetre over a few centimetres is
+  // degrees). 0: seams never turn the face. Metres.
+  double seam_turn_min_length_m = 0.1;
   // Iterations of measure-and-update. Count.
   int iterations = 2;
   // A hypothesis whose first iteration finds a side running on flat and no

@@ -123,6 +123,36 @@ TEST(RefineOnGraspFaceTest, TouchingCartonsMeetAtASeam) {
   EXPECT_LT(e.rotation_deg, 1.0);
 }
 
+// A carton in the middle of a 3 x 3 block with 3 mm gaps: seams on all four
+// sides, no free one. Its turn comes from where each half of its long
+// sides has the seam (RefinementOptions::seam_turn_min_length_m): a
+// reading turned by 3 degrees comes back square; with seams giving a
+// position only, it keeps the turn.
+TEST(RefineOnGraspFaceTest, SeamsAlongLongSidesTurnTheFace) {
+  std::vector<SceneBox> boxes;
+  for (int row = -1; row <= 1; ++row) {
+    for (int col = -1; col <= 1; ++col) {
+      boxes.push_back(Flat(kCartonS, col * (kCartonS.l + 0.003), row * (kCartonS.b + 0.003)));
+    }
+  }
+  std::swap(boxes[0], boxes[4]);  // the middle one first: the camera looks at it
+  const FlatScene s = RenderFlat(boxes, 1.3);
+  const GroundTruthBox& gt = s.rendered.boxes[0];
+  auto refine = [&](double seam_turn) {
+    RefinementOptions o;
+    o.seam_turn_min_length_m = seam_turn;
+    Eigen::Isometry3d pose = Moved(gt.camera_T_box, 0.002, 0.002, 3.0);
+    const RefinementResult r = RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), o, &pose);
+    EXPECT_TRUE(r.ok);
+    if (seam_turn > 0.0) EXPECT_EQ(std::count(r.sides.begin(), r.sides.end(), SideKind::kSeam), 4);
+    return ComparePoses(pose, gt.camera_T_box, kCartonS);
+  };
+  const PoseError turned = refine(0.1);
+  EXPECT_LT(turned.rotation_deg, 1.0);
+  EXPECT_LT(turned.translation_m, 0.003);
+  EXPECT_GT(refine(0.0).rotation_deg, 2.5) << "seams give a position only";
+}
+
 // With a colour image, a groove in the depth is a seam only where an image
 // line runs along it (RefinementOptions::colour_confirms_seam): the same
 // 3 mm gap is a seam when the image shows the gap darker than the cartons,

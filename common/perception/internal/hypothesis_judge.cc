@@ -106,8 +106,9 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
 namespace {
 
 // Every side of the grasp face measured where the face ends (free or a
-// seam), with a free side on each axis (a seam gives a position but no
-// turn): the face is pinned down though a corner of it lies out of view.
+// seam), with a free side on each axis (a free side's turn is surer than
+// a seam's, which a short side does not give at all): the face is pinned
+// down though a corner of it lies out of view.
 bool PinnedOnEverySide(const std::array<SideKind, 4>& sides) {
   auto ends = [](SideKind k) { return k == SideKind::kFree || k == SideKind::kSeam; };
   return std::all_of(sides.begin(), sides.end(), ends) &&
