@@ -473,9 +473,16 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
   // offset (within a millimetre), if only a weak one. A cluster of missing
   // returns in one place (Kinect speckle) makes a dip in the whole side's
   // sums but not in both halves.
+  // Each half's scan, made once for both uses below.
+  std::array<std::optional<SeamScan>, 2> halves;
+  auto half_scan = [&](int k) -> const SeamScan& {
+    if (!halves[k])
+      halves[k].emplace(k == 0 ? whole.Stretch(-kAll, 0.0) : whole.Stretch(0.0, kAll));
+    return *halves[k];
+  };
   if (o.seam_halves_min_strength > -1.0) {
-    for (const auto& [lo, hi] : {std::pair{-kAll, 0.0}, std::pair{0.0, kAll}}) {
-      const SeamScan part = whole.Stretch(lo, hi);
+    for (int k = 0; k < 2; ++k) {
+      const SeamScan& part = half_scan(k);
       double strongest = -kAll;
       for (double c = *best - 0.001; c <= *best + 0.001 + 1e-9; c += 0.001) {
         if (const std::optional<double> st = part.Strength(c)) strongest = std::max(strongest, *st);
@@ -490,9 +497,8 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
       2.0 * reach >= o.seam_turn_min_length_m) {
     double at[2];
     bool found = true;
-    int k = 0;
-    for (const auto& [lo, hi] : {std::pair{-kAll, 0.0}, std::pair{0.0, kAll}}) {
-      const SeamScan part = whole.Stretch(lo, hi);
+    for (int k = 0; k < 2; ++k) {
+      const SeamScan& part = half_scan(k);
       double strongest = 0.0;
       std::optional<double> pos;
       for (double c = *best - 0.004; c <= *best + 0.004 + 1e-9; c += 0.0005) {
@@ -503,9 +509,11 @@ std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
         }
       }
       if (!pos) found = false;
-      at[k++] = pos.value_or(0.0);
+      at[k] = pos.value_or(0.0);
     }
-    if (found) *slope = (at[1] - at[0]) / reach;  // half centres reach/2 either side
+    // The halves' centres lie reach / 2 either side of the middle.
+    const double cap = std::tan(o.seam_turn_max_deg * std::numbers::pi / 180.0);
+    if (found) *slope = std::clamp((at[1] - at[0]) / reach, -cap, cap);
   }
   return half + *best;
 }
@@ -881,6 +889,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.iterations", iterations, 0, 20),
            CheckRange("refinement.end_on_flat_shift_m", end_on_flat_shift_m, 0.0, 0.05),
            CheckRange("refinement.seam_turn_min_length_m", seam_turn_min_length_m, 0.0, 10.0),
+           CheckRange("refinement.seam_turn_max_deg", seam_turn_max_deg, 0.0, 45.0),
            CheckPositive("refinement.max_shift_m", max_shift_m),
            CheckPositive("refinement.max_turn_deg", max_turn_deg),
        }) {

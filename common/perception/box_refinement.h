@@ -95,6 +95,11 @@ struct RefinementOptions {
   // sides give a position only (a millimetre over a few centimetres is
   // degrees). 0: seams never turn the face. Metres.
   double seam_turn_min_length_m = 0.1;
+  // ... by at most this much per iteration: a seam's two halves lie a few
+  // centimetres apart and their offsets are noisy (a larger turn is made
+  // over the iterations, and a neighbour starts from its proposer's turn).
+  // Degrees.
+  double seam_turn_max_deg = 2.0;
   // Iterations of measure-and-update. Count.
   int iterations = 2;
   // A hypothesis whose first iteration finds a side running on flat and no

@@ -324,13 +324,15 @@ TEST(RefineOnGraspFaceTest, AReadingOnABiggerFaceEndsAfterItsFirstStep) {
   EXPECT_FALSE(slid_pose.isApprox(refine(0.01, one_step).second, 1e-12));
 }
 
-TEST(RefinementOptionsTest, ValidateNamesTheEndOnFlatShift) {
+TEST(RefinementOptionsTest, ValidateNamesTheNewFields) {
   RefinementOptions o;
   EXPECT_TRUE(o.Validate().ok());
   o.end_on_flat_shift_m = -0.001;
   EXPECT_NE(o.Validate().message().find("end_on_flat_shift_m"), std::string::npos);
   o.end_on_flat_shift_m = 0.0;
   EXPECT_TRUE(o.Validate().ok()) << "0: every step";
+  o.seam_turn_max_deg = 90.0;
+  EXPECT_NE(o.Validate().message().find("seam_turn_max_deg"), std::string::npos);
 }
 
 // A carton of the layer under another that stands on it right at the
