@@ -138,8 +138,7 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
     }
     double sa = 0, sb = 0, sn = 0, saa = 0, sab = 0, san = 0, sbb = 0, sbn = 0, snn = 0;
     // The ray-plane grid near the sides (pixels outside (skip0, skip1)).
-    auto grid = [&](int u) {
-      const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row, n_r = n_x[u - ua] + n_row;
+    auto grid = [&](int u, double a_r, double b_r, double n_r) {
       if (std::abs(n_r) <= 1e-6) return;
       const double t = n_c / n_r;
       const double qa = t * a_r - a_c, qb = t * b_r - b_c;
@@ -151,10 +150,9 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
       }
     };
     // The measured point, every pixel.
-    auto measured = [&](int u) {
+    auto measured = [&](int u, double a_r, double b_r, double n_r) {
       const float z = zrow[u];
       if (std::isnan(z)) return;
-      const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row, n_r = n_x[u - ua] + n_row;
       const FacePoint q{z * a_r - a_c, z * b_r - b_c, z * n_r - n_c};
       if (std::abs(q.a) > lim_a || std::abs(q.b) > lim_b) return;
       if (q.n > plane_tol) {
@@ -182,16 +180,18 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
     const int mid0 = static_cast<int>(std::floor(std::clamp(skip0, ua - 1.0, ub + 1.0))) + 1;
     const int mid1 = static_cast<int>(std::ceil(std::clamp(skip1, ua - 1.0, ub + 1.0))) - 1;
     const int left_end = mid0 <= mid1 ? std::min(ub, mid0 - 1) : ub;
-    for (int u = ua; u <= left_end; ++u) {
-      grid(u);
-      measured(u);
-    }
+    // The pixel's ray terms (a.r, b.r, n.r), shared by both readers.
+    auto both = [&](int u) {
+      const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row, n_r = n_x[u - ua] + n_row;
+      grid(u, a_r, b_r, n_r);
+      measured(u, a_r, b_r, n_r);
+    };
+    for (int u = ua; u <= left_end; ++u) both(u);
     if (mid0 <= mid1) {
-      for (int u = std::max(ua, mid0); u <= std::min(ub, mid1); ++u) measured(u);
-      for (int u = std::max(ua, mid1 + 1); u <= ub; ++u) {
-        grid(u);
-        measured(u);
+      for (int u = std::max(ua, mid0); u <= std::min(ub, mid1); ++u) {
+        measured(u, a_x[u - ua] + a_row, b_x[u - ua] + b_row, n_x[u - ua] + n_row);
       }
+      for (int u = std::max(ua, mid1 + 1); u <= ub; ++u) both(u);
     }
     out.sum += Eigen::Vector3d(sa, sb, sn);
     out.sum_outer += (Eigen::Matrix3d() << saa, sab, san, sab, sbb, sbn, san, sbn, snn).finished();
@@ -968,17 +968,15 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
   result.extent_a_m = pa.measured() && ma.measured() ? pa.position + ma.position : 0.0;
   result.extent_b_m = pb.measured() && mb.measured() ? pb.position + mb.position : 0.0;
   // Turn about the normal: a side along b (the +-a sides) turning by
-  // slope s means the a axis turns by -s toward b... average all sides.
+  // slope s means the a axis turns by -s toward b... the median of every
+  // side's: a free side's, and a seam's where it has one
+  // (RefinementOptions::seam_turn_min_length_m).
   std::vector<double> turns;
-  if (pa.kind == SideKind::kFree) turns.push_back(-pa.slope);
-  if (ma.kind == SideKind::kFree) turns.push_back(ma.slope);
-  if (pb.kind == SideKind::kFree) turns.push_back(pb.slope);
-  if (mb.kind == SideKind::kFree) turns.push_back(-mb.slope);
-  // Seams turn the face too (RefinementOptions::seam_turn_min_length_m).
-  if (pa.kind == SideKind::kSeam && pa.seam_slope) turns.push_back(-*pa.seam_slope);
-  if (ma.kind == SideKind::kSeam && ma.seam_slope) turns.push_back(*ma.seam_slope);
-  if (pb.kind == SideKind::kSeam && pb.seam_slope) turns.push_back(*pb.seam_slope);
-  if (mb.kind == SideKind::kSeam && mb.seam_slope) turns.push_back(-*mb.seam_slope);
+  for (const auto& [m, s] :
+       {std::pair{&pa, -1.0}, std::pair{&ma, 1.0}, std::pair{&pb, 1.0}, std::pair{&mb, -1.0}}) {
+    if (m->kind == SideKind::kFree) turns.push_back(s * m->slope);
+    if (m->kind == SideKind::kSeam && m->seam_slope) turns.push_back(s * *m->seam_slope);
+  }
   double turn = 0.0;
   if (!turns.empty()) turn = std::atan(Median(turns));
 

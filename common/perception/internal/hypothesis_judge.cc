@@ -145,19 +145,21 @@ void HypothesisJudge::Propose(const Eigen::Isometry3d& camera_T_box, int corners
   queue_.push_back({camera_T_box, corners, std::move(segments), from_face, retry});
 }
 
-void HypothesisJudge::ProposeNeighbour(const Eigen::Isometry3d& camera_T_box, bool chained) {
+HypothesisJudge::Proposal* HypothesisJudge::ProposeBare(const Eigen::Isometry3d& camera_T_box) {
   const size_t queued = queue_.size();
   Propose(camera_T_box, 0, {});
-  if (queue_.size() > queued) {
-    queue_.back().neighbour = true;
-    queue_.back().chained = chained;
+  return queue_.size() > queued ? &queue_.back() : nullptr;
+}
+
+void HypothesisJudge::ProposeNeighbour(const Eigen::Isometry3d& camera_T_box, bool chained) {
+  if (Proposal* p = ProposeBare(camera_T_box)) {
+    p->neighbour = true;
+    p->chained = chained;
   }
 }
 
 void HypothesisJudge::ProposePastDeclined(const Eigen::Isometry3d& camera_T_box, int steps) {
-  const size_t queued = queue_.size();
-  Propose(camera_T_box, 0, {});
-  if (queue_.size() > queued) queue_.back().past_declined = steps;
+  if (Proposal* p = ProposeBare(camera_T_box)) p->past_declined = steps;
 }
 
 std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {

@@ -94,6 +94,9 @@ class HypothesisJudge {
     int past_declined = 0;   // proposed by a stepping stone this many declined boxes past
                              // the last accepted (0: not)
   };
+  // Propose() with no corners or segments: the queued proposal, for the
+  // caller to mark, or null when it was seen before.
+  Proposal* ProposeBare(const Eigen::Isometry3d& camera_T_box);
   // Evaluates one proposal; false when rejected. `refined` is set when it
   // got as far as refinement; then `reason` says why it was rejected, and
   // out->box holds the refined pose and out->box.score its first support.
