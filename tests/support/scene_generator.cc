@@ -171,7 +171,7 @@ RenderedScene Render(const Scene& scene, const SensorOptions& sensor) {
     out.cloud.rgb = sensor.kind == SensorKind::kTimeOfFlight
                         ? std::move(infrared)
                         : internal::RenderColor(scene, caster, texture, nominal, sensor.color,
-                                                scene.noise_seed ^ 0xC0105EEDu);
+                                                scene.LookSeed() ^ 0xC0105EEDu);
   }
   return out;
 }

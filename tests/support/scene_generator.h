@@ -39,6 +39,11 @@ struct Scene {
   std::vector<SupportPart> supports;
   bool floor = true;
   uint32_t noise_seed = 1;  // seeds Render's noise: same seed, same cloud
+  // Seeds the surfaces' look (shades, tape, print, infrared albedo) and the
+  // colour image's light; 0: noise_seed. A recording of one scene keeps the
+  // look and draws new noise per frame (make_frames --take_every).
+  uint32_t look_seed = 0;
+  uint32_t LookSeed() const { return look_seed != 0 ? look_seed : noise_seed; }
 };
 
 // A camera looking down at look_at_world from distance_m along its optical
@@ -110,9 +115,9 @@ struct RenderStats {
   int no_return = 0;  // ray hit nothing (sky) or out of range
   int shadow = 0;
   int grazing = 0;
-  int flying = 0;  // valid but moved to a mixed depth
-  int dropout = 0;  // random and speckle holes, blobs, low signal (tof)
-  int filled = 0;   // valid, depth taken from the sides of a thin gap or hole (stereo)
+  int flying = 0;     // valid but moved to a mixed depth
+  int dropout = 0;    // random and speckle holes, blobs, low signal (tof)
+  int filled = 0;     // valid, depth taken from the sides of a thin gap or hole (stereo)
   int multipath = 0;  // valid, biased by more than 1 mm by multipath (tof)
 };
 

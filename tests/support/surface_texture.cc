@@ -53,11 +53,11 @@ double ValueNoise(double x, double y, uint32_t seed) {
 SurfaceTexture::SurfaceTexture(const Scene& scene, const RayCaster& caster)
     : caster_(caster), world_T_camera_(scene.world_T_camera) {
   // Its own stream: the look never disturbs the depth noise.
-  std::mt19937 rng(Hash(scene.noise_seed, 0xC010u, 7u));
+  std::mt19937 rng(Hash(scene.LookSeed(), 0xC010u, 7u));
   for (size_t i = 0; i < scene.boxes.size(); ++i) {
     const BoxDims& dims = scene.boxes[i].dims;
     BoxLook look;
-    look.seed = Hash(scene.noise_seed, static_cast<uint32_t>(i), 11u);
+    look.seed = Hash(scene.LookSeed(), static_cast<uint32_t>(i), 11u);
     look.brick = IsBrick(dims);
     const double shade = Uniform(rng, 0.85, 1.12);
     if (look.brick) {
@@ -128,7 +128,7 @@ SurfaceTexture::SurfaceTexture(const Scene& scene, const RayCaster& caster)
   for (size_t j = 0; j < scene.supports.size(); ++j) {
     const SupportPart& part = scene.supports[j];
     PartLook look;
-    look.seed = Hash(scene.noise_seed, static_cast<uint32_t>(j), 13u);
+    look.seed = Hash(scene.LookSeed(), static_cast<uint32_t>(j), 13u);
     const double shade = Uniform(rng, 0.8, 1.15);
     if (part.name.find("leg") != std::string::npos) {
       look.base = Eigen::Vector3d(0.05, 0.05, 0.055) * shade;
@@ -147,7 +147,7 @@ SurfaceTexture::SurfaceTexture(const Scene& scene, const RayCaster& caster)
     parts_.push_back(look);
   }
   floor_base_ = Eigen::Vector3d(1.0, 0.98, 0.93) * Uniform(rng, 0.14, 0.3);
-  floor_seed_ = Hash(scene.noise_seed, 0xF100u, 17u);
+  floor_seed_ = Hash(scene.LookSeed(), 0xF100u, 17u);
 }
 
 Eigen::Vector3d SurfaceTexture::BoxAlbedo(int i, int face, const Eigen::Vector3d& q) const {
