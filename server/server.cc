@@ -120,7 +120,8 @@ absl::StatusOr<std::unique_ptr<RunningServer>> StartServer(const ServerOptions& 
       pool.get(), options.detector, std::move(sources), options.box_models,
       ServiceLimits{.max_streams = options.max_streams,
                     .default_deadline = absl::Milliseconds(options.default_deadline_ms),
-                    .max_deadline = absl::Milliseconds(options.max_deadline_ms)});
+                    .max_deadline = absl::Milliseconds(options.max_deadline_ms),
+                    .carry_unchanged_frames = options.carry_unchanged_frames});
 
   grpc::ServerBuilder builder;
   ConfigureReflection(builder, options.enable_reflection);

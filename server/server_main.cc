@@ -79,6 +79,9 @@ ABSL_FLAG(std::string, tls_cert, "", "PEM certificate (chain) of the server; wit
 ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
 ABSL_FLAG(std::string, tls_client_ca, "",
           "PEM CA bundle; when set, clients must present a certificate it signed (mutual TLS)");
+ABSL_FLAG(bool, carry_unchanged_frames, cornerpose::server::ServerOptions{}.carry_unchanged_frames,
+          "streams: a frame showing the same scene as the last one detected on gets its "
+          "detection without a detector run");
 ABSL_FLAG(bool, reflection, cornerpose::server::ServerOptions{}.enable_reflection,
           "serve gRPC reflection (off in production)");
 ABSL_FLAG(std::vector<std::string>, source, {},
@@ -224,6 +227,10 @@ int main(int argc, char** argv) {
   if (given("tls_cert")) options.tls_cert = absl::GetFlag(FLAGS_tls_cert);
   if (given("tls_key")) options.tls_key = absl::GetFlag(FLAGS_tls_key);
   if (given("tls_client_ca")) options.tls_client_ca = absl::GetFlag(FLAGS_tls_client_ca);
+  if (given("carry_unchanged_frames") ||
+      SpecifiedOnCommandLine(argc, argv, "nocarry_unchanged_frames")) {
+    options.carry_unchanged_frames = absl::GetFlag(FLAGS_carry_unchanged_frames);
+  }
   if (given("reflection") || SpecifiedOnCommandLine(argc, argv, "noreflection")) {
     options.enable_reflection = absl::GetFlag(FLAGS_reflection);
   }

@@ -5,12 +5,19 @@
 //
 //   make_frames --out DIR [--kind KIND] [--count N] [--seed S] [--box NAME|L,B,H]
 //               [--sensor kinect|tof|stereo] [--resolution WxH] [--color] [--pcd]
+//               [--take_every N]
 //
 // Kinds: isolated, heap, pallet (a grid with 2-4 mm gaps, 1-2 layers),
 // touching (a pallet of touching cartons, 0-3 mm gaps, at one layer or two
 // heights, with 1-3 boxes of another size on the top layer), cell (the demo
 // cell's view), mixed (isolated, heap, pallet in turn) and depal (isolated,
 // heap, touching at one layer, touching at two heights in turn).
+//
+// --take_every N makes a recording of one scene instead (frames rec_0000,
+// rec_0001, ...; the first scene of --kind): frame i shows it with i / N of
+// its boxes taken away, the highest first, as a cell empties a pallet, and
+// every frame draws new sensor noise on the same surfaces (a camera watching
+// the cell at N frames a pick).
 //
 // Writes per frame NAME.png (16-bit depth, millimetres, 0 = no return), with
 // --color NAME.color.png (8-bit RGB registered to the depth; grey infrared
@@ -19,6 +26,7 @@
 // ../shared/tools/score.py; and for the set intrinsics.txt
 // ("width,height,fx,fy,cx,cy") and index.json. The same arguments always give
 // the same frames; the kinect frames are those of earlier versions.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -26,6 +34,7 @@
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,7 +62,7 @@ nlohmann::json Matrix(const Eigen::Isometry3d& T) {
 
 struct Args {
   std::string out, kind = "mixed", box = "carton_s", sensor = "kinect";
-  int count = 6, width = 0, height = 0;
+  int count = 6, width = 0, height = 0, take_every = 0;
   uint32_t seed = 1;
   bool pcd = false, color = false;
 };
@@ -92,6 +101,27 @@ absl::Status SaveColorPng(const std::string& path, const PointCloud& cloud) {
   return WriteRgbPng(path, bytes, cloud.width, cloud.height);
 }
 
+// The box whose top reaches highest above the floor (a cell takes it next).
+size_t HighestBox(const testing::Scene& scene) {
+  size_t best = 0;
+  double best_top = -1e9;
+  for (size_t i = 0; i < scene.boxes.size(); ++i) {
+    const testing::SceneBox& box = scene.boxes[i];
+    double top = -1e9;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner((c & 1 ? 0.5 : -0.5) * box.dims.l,
+                                   (c & 2 ? 0.5 : -0.5) * box.dims.b,
+                                   (c & 4 ? 0.5 : -0.5) * box.dims.h);
+      top = std::max(top, (box.world_T_box * corner).z());
+    }
+    if (top > best_top) {
+      best_top = top;
+      best = i;
+    }
+  }
+  return best;
+}
+
 int Run(const Args& a) {
   absl::StatusOr<BoxDims> dims = ParseBoxDims(a.box);
   absl::StatusOr<testing::SensorKind> sensor_kind = testing::ParseSensorKind(a.sensor);
@@ -114,6 +144,8 @@ int Run(const Args& a) {
                           {"sensor", a.sensor},
                           {"scenes", nlohmann::json::array()}};
   CameraIntrinsics camera = *intrinsics;
+  std::optional<testing::Scene> recorded;  // --take_every: the scene recorded, and its type
+  std::string recorded_type;
   for (int i = 0; i < a.count; ++i) {
     static const char* kMixed[] = {"isolated", "heap", "pallet"};
     static const char* kDepal[] = {"isolated", "heap", "touching1", "touching2"};
@@ -123,14 +155,30 @@ int Run(const Args& a) {
     const uint32_t seed = a.seed * 1000 + i;
     std::string type;
     absl::StatusOr<testing::Scene> scene =
-        testing::MakeSceneOfKind(kind, *dims, i, seed, placement, &type);
+        a.take_every > 0 && recorded
+            ? absl::StatusOr<testing::Scene>(*recorded)
+            : testing::MakeSceneOfKind(kind, *dims, a.take_every > 0 ? 0 : i,
+                                       a.take_every > 0 ? a.seed * 1000 : seed, placement, &type);
     if (!scene.ok()) {
       std::fprintf(stderr, "make_frames: %s\n", scene.status().ToString().c_str());
       return 2;
     }
+    if (a.take_every > 0) {
+      if (!recorded) {
+        recorded = *scene;
+        recorded->look_seed = recorded->LookSeed();
+        recorded_type = type;
+      }
+      type = recorded_type;
+      scene->noise_seed = recorded->noise_seed + static_cast<uint32_t>(i);
+      for (int taken = 0; taken < i / a.take_every && !scene->boxes.empty(); ++taken) {
+        scene->boxes.erase(scene->boxes.begin() + HighestBox(*scene));
+      }
+    }
     const testing::RenderedScene r = testing::Render(*scene, sensor);
     camera = r.camera;
-    const std::string id = absl::StrFormat("%s_%03d", kind, i);
+    const std::string id =
+        a.take_every > 0 ? absl::StrFormat("rec_%04d", i) : absl::StrFormat("%s_%03d", kind, i);
     std::vector<uint16_t> depth(r.cloud.size(), 0);
     for (size_t p = 0; p < r.cloud.size(); ++p) {
       const float z = r.cloud.xyz[p].z();
@@ -222,12 +270,15 @@ int main(int argc, char** argv) {
       ++i;
     } else if (k == "--seed" && has_value && absl::SimpleAtoi(argv[i + 1], &a.seed)) {
       ++i;
+    } else if (k == "--take_every" && has_value && absl::SimpleAtoi(argv[i + 1], &a.take_every) &&
+               a.take_every > 0) {
+      ++i;
     } else {
       std::fprintf(stderr,
                    "usage: make_frames --out DIR "
                    "[--kind isolated|heap|pallet|touching|cell|mixed|depal] [--count N] "
                    "[--seed S] [--box NAME|L,B,H] [--sensor kinect|tof|stereo] "
-                   "[--resolution WxH] [--color] [--pcd]\n");
+                   "[--resolution WxH] [--color] [--pcd] [--take_every N]\n");
       return 2;
     }
   }

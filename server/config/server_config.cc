@@ -87,6 +87,9 @@ absl::StatusOr<ServerOptions> LoadServerConfig(const std::string& path) {
   options.http.cell_status_tls_key = resolve(config.cell_status_tls_key());
   options.http.cell_status_tls_server_name = config.cell_status_tls_server_name();
   if (config.has_enable_reflection()) options.enable_reflection = config.enable_reflection();
+  if (config.has_carry_unchanged_frames()) {
+    options.carry_unchanged_frames = config.carry_unchanged_frames();
+  }
   if (absl::Status s = options.Validate(); !s.ok()) return Invalid(path, std::string(s.message()));
   std::set<std::string> names;
   for (int i = 0; i < config.sources_size(); ++i) {

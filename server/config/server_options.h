@@ -88,6 +88,10 @@ struct ServerOptions {
   std::string tls_client_ca{};
   // gRPC server reflection (grpcurl without the protos). Off in production.
   bool enable_reflection = true;
+  // StreamDetections: a frame showing the same scene as the last frame
+  // detected on (CompareFrames) gets that detection without a detector run
+  // (README, "Streams").
+  bool carry_unchanged_frames = true;
 
   // The detector options every request starts from (its box is unused: a
   // request names the box).

@@ -12,6 +12,7 @@ v1::DetectResponse MakeDetectResponse(const Detection& detection, const Detector
   *response.mutable_box_dims_used() = wire::ToProto(options.box);
   if (frame == nullptr) return response;
   response.set_frame_id(frame->id);
+  response.set_detected_frame_id(frame->id);
   response.set_capture_time_unix_nanos(absl::ToUnixNanos(frame->capture_time));
   response.set_source(frame->source);
   response.set_source_live(frame->live);

@@ -121,7 +121,11 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, absl::Time deadline
 PerceptionServiceImpl::PerceptionServiceImpl(DetectionPool* pool, const DetectorOptions& defaults,
                                              std::vector<std::unique_ptr<FrameSource>> sources,
                                              BoxModels box_models, ServiceLimits limits)
-    : pool_(pool), defaults_(defaults), box_models_(std::move(box_models)), limits_(limits) {
+    : pool_(pool),
+      defaults_(defaults),
+      box_models_(std::move(box_models)),
+      limits_(limits),
+      shared_(limits.carry_unchanged_frames) {
   for (std::unique_ptr<FrameSource>& source : sources) {
     const std::string name = source->name();
     sources_.emplace(name, std::move(source));
@@ -202,12 +206,13 @@ grpc::ServerWriteReactor<v1::DetectResponse>* PerceptionServiceImpl::StreamDetec
   v1::StreamDetectionsRequest parameters = *request;
   parameters.clear_include_edge_points();
   parameters.clear_include_cloud();
+  parameters.clear_every_frame();
   std::string share_key = parameters.SerializeAsString();
   return new StreamDetectionsReactor(pool_, &shared_, std::move(share_key), it->second.get(),
                                      *std::move(options),
                                      {.include_edge_points = request->include_edge_points(),
                                       .include_cloud = request->include_cloud()},
-                                     &stopping_streams_, &open_streams_);
+                                     request->every_frame(), &stopping_streams_, &open_streams_);
 }
 
 }  // namespace cornerpose::server

@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "absl/time/time.h"
-
 #include "common/perception/detector.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
 #include "server/service/detect_request.h"
@@ -25,6 +24,7 @@ struct ServiceLimits {
   int max_streams = 16;
   absl::Duration default_deadline = absl::Seconds(10);
   absl::Duration max_deadline = absl::Seconds(60);
+  bool carry_unchanged_frames = true;  // SharedDetections
 };
 
 class PerceptionServiceImpl final : public v1::PerceptionService::CallbackService {
@@ -62,8 +62,10 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
     for (const auto& [name, source] : sources_) out.push_back(source.get());
     return out;
   }
-  // Detections streams started (shared ones counted once), and streams open.
+  // Detections streams started (shared ones counted once; frames carried
+  // not counted), frames carried, and streams open.
   uint64_t stream_detections_started() const { return shared_.started(); }
+  uint64_t stream_frames_carried() const { return shared_.carried(); }
   int open_streams() const { return open_streams_.load(); }
 
  private:

@@ -1,13 +1,18 @@
 #include "server/service/shared_detections.h"
 
+#include <algorithm>
+#include <chrono>
 #include <iterator>
 #include <utility>
+
+#include "common/perception/camera_model.h"
+#include "common/perception/frame_change.h"
 
 namespace cornerpose::server {
 
 std::shared_ptr<const SharedDetection> SharedDetections::Get(const std::string& key, Frame frame,
-                                                              const DetectorOptions& options,
-                                                              DetectionPool* pool) {
+                                                             const DetectorOptions& options,
+                                                             DetectionPool* pool) {
   auto promise = std::make_shared<std::promise<absl::StatusOr<Detection>>>();
   std::shared_ptr<SharedDetection> entry;
   {
@@ -19,6 +24,7 @@ std::shared_ptr<const SharedDetection> SharedDetections::Get(const std::string& 
         return held;
       }
     }
+    std::shared_ptr<const SharedDetection> last = it != latest_.end() ? it->second.lock() : nullptr;
     for (auto e = latest_.begin(); e != latest_.end();) {
       e = e->second.expired() ? latest_.erase(e) : std::next(e);
     }
@@ -26,6 +32,16 @@ std::shared_ptr<const SharedDetection> SharedDetections::Get(const std::string& 
     entry->frame_id = frame.id;
     entry->options = options;
     UseFrameCamera(frame.camera, &entry->options);  // as Detect does
+    if (std::shared_ptr<const SharedDetection> carrier = Carrier(last, frame, entry->options)) {
+      entry->detected_frame_id = carrier->frame_id;
+      entry->result = carrier->result;
+      entry->detected = std::move(carrier);
+      entry->frame = std::make_shared<const Frame>(std::move(frame));
+      latest_[key] = entry;
+      ++carried_;
+      return entry;
+    }
+    entry->detected_frame_id = frame.id;
     entry->frame = std::make_shared<const Frame>(std::move(frame));
     entry->result = promise->get_future().share();
     latest_[key] = entry;
@@ -43,9 +59,38 @@ std::shared_ptr<const SharedDetection> SharedDetections::Get(const std::string& 
   return entry;
 }
 
+std::shared_ptr<const SharedDetection> SharedDetections::Carrier(
+    const std::shared_ptr<const SharedDetection>& last, const Frame& frame,
+    const DetectorOptions& options) const {
+  if (!carry_unchanged_ || last == nullptr) return nullptr;
+  // Always against the frame detected on, so that slow drift adds up.
+  const std::shared_ptr<const SharedDetection> detected =
+      last->detected != nullptr ? last->detected : last;
+  // Only a finished detection without error is carried (one still running
+  // is shared by the streams on its own frame).
+  if (detected->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready ||
+      !detected->result.get().ok()) {
+    return nullptr;
+  }
+  FrameChangeOptions compare;
+  compare.box_side_m = std::min({options.box.l, options.box.b, options.box.h});
+  if (options.camera) {
+    compare.focal_px = options.camera->fx;
+  } else if (absl::StatusOr<CameraIntrinsics> k = EstimateIntrinsics(frame.cloud); k.ok()) {
+    compare.focal_px = k->fx;
+  }
+  absl::StatusOr<FrameChange> change = CompareFrames(detected->frame->cloud, frame.cloud, compare);
+  return change.ok() && change->same_scene ? detected : nullptr;
+}
+
 uint64_t SharedDetections::started() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return started_;
+}
+
+uint64_t SharedDetections::carried() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return carried_;
 }
 
 }  // namespace cornerpose::server

@@ -18,6 +18,7 @@ StreamDetectionsReactor::StreamDetectionsReactor(const grpc::Status& error) { Fi
 StreamDetectionsReactor::StreamDetectionsReactor(DetectionPool* pool, SharedDetections* shared,
                                                  std::string share_key, FrameSource* source,
                                                  DetectorOptions options, ResponseContents contents,
+                                                 bool every_frame,
                                                  const std::atomic<bool>* stopping,
                                                  std::atomic<int>* open_streams)
     : pool_(pool),
@@ -26,6 +27,7 @@ StreamDetectionsReactor::StreamDetectionsReactor(DetectionPool* pool, SharedDete
       source_(source),
       options_(std::move(options)),
       contents_(contents),
+      every_frame_(every_frame),
       stopping_(stopping),
       open_streams_(open_streams) {
   thread_ = std::thread([this] { Run(); });
@@ -78,7 +80,8 @@ void StreamDetectionsReactor::Run() {
   uint64_t last_id = 0;
   grpc::Status end;
   while ((end = ShouldStop()).ok()) {
-    absl::StatusOr<Frame> frame = source_->GrabNewerThan(last_id, kPollPeriod);
+    absl::StatusOr<Frame> frame = every_frame_ ? source_->GrabAfter(last_id, kPollPeriod)
+                                               : source_->GrabNewerThan(last_id, kPollPeriod);
     if (!frame.ok()) {
       if (frame.status().code() == absl::StatusCode::kOutOfRange) break;  // played once: done
       if (source_->state().state == SourceState::kFailed) {
@@ -98,6 +101,7 @@ void StreamDetectionsReactor::Run() {
       break;
     }
     response_ = MakeDetectResponse(*result, current_->options, current_->frame.get(), contents_);
+    response_.set_detected_frame_id(current_->detected_frame_id);
 
     std::unique_lock<std::mutex> lock(mutex_);
     write_pending_ = true;

@@ -30,11 +30,14 @@ class StreamDetectionsReactor final : public grpc::ServerWriteReactor<v1::Detect
   explicit StreamDetectionsReactor(const grpc::Status& error);
   // Streams until cancelled, the source ends or fails, or *stopping is set
   // (server shutdown). `share_key` names the source and the parameters that
-  // change the detection. *open_streams is decremented when the RPC is done.
+  // change the detection. With `every_frame` it asks the source for the
+  // frame after the last (FrameSource::GrabAfter), not the newest.
+  // *open_streams is decremented when the RPC is done.
   // Everything pointed to outlives the RPC.
   StreamDetectionsReactor(DetectionPool* pool, SharedDetections* shared, std::string share_key,
                           FrameSource* source, DetectorOptions options, ResponseContents contents,
-                          const std::atomic<bool>* stopping, std::atomic<int>* open_streams);
+                          bool every_frame, const std::atomic<bool>* stopping,
+                          std::atomic<int>* open_streams);
 
   void OnWriteDone(bool ok) override;
   void OnCancel() override;
@@ -51,15 +54,16 @@ class StreamDetectionsReactor final : public grpc::ServerWriteReactor<v1::Detect
   FrameSource* source_ = nullptr;
   const DetectorOptions options_;
   const ResponseContents contents_;
+  const bool every_frame_ = false;
   const std::atomic<bool>* stopping_ = nullptr;
   std::atomic<int>* open_streams_ = nullptr;
 
   std::mutex mutex_;
   std::condition_variable changed_;
-  bool write_pending_ = false;   // guarded by mutex_
-  bool write_ok_ = true;         // guarded by mutex_
-  bool cancelled_ = false;       // guarded by mutex_
-  v1::DetectResponse response_;  // owned by the write in flight
+  bool write_pending_ = false;                      // guarded by mutex_
+  bool write_ok_ = true;                            // guarded by mutex_
+  bool cancelled_ = false;                          // guarded by mutex_
+  v1::DetectResponse response_;                     // owned by the write in flight
   std::shared_ptr<const SharedDetection> current_;  // Run's thread only
   std::thread thread_;
 };

@@ -110,6 +110,10 @@ absl::StatusOr<Frame> DirectorySource::GrabNewerThan(uint64_t last_id, absl::Dur
   return frames_.GrabNewerThan(last_id, timeout);
 }
 
+absl::StatusOr<Frame> DirectorySource::GrabAfter(uint64_t last_id, absl::Duration timeout) {
+  return frames_.GrabAfter(last_id, timeout);
+}
+
 SourceStatus DirectorySource::state() const { return frames_.state(); }
 
 void DirectorySource::Run() {

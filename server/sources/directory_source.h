@@ -41,6 +41,7 @@ class DirectorySource final : public FrameSource {
   const std::string& name() const override { return name_; }
   std::string description() const override { return directory_; }
   absl::StatusOr<Frame> GrabNewerThan(uint64_t last_id, absl::Duration timeout) override;
+  absl::StatusOr<Frame> GrabAfter(uint64_t last_id, absl::Duration timeout) override;
   SourceStatus state() const override;
   // Recorded frames: always a replay.
   bool live() const override { return false; }

@@ -41,6 +41,11 @@ struct SourceStatus {
   std::string reason;
 };
 
+// How many of its newest frames a source keeps for readers a few frames
+// behind (FrameSource::GrabAfter): 200 ms at 30 frames a second, 22 MB of
+// VGA clouds.
+inline constexpr int kKeptFrames = 6;
+
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
@@ -58,6 +63,12 @@ class FrameSource {
   // a stream asks for the next frame without seeing one twice). UNAVAILABLE
   // as Grab; OUT_OF_RANGE when the source finished with no newer frame.
   virtual absl::StatusOr<Frame> GrabNewerThan(uint64_t last_id, absl::Duration timeout) = 0;
+
+  // The frame after last_id: the oldest the source still keeps (its last
+  // kKeptFrames) with id > last_id, or the newest when the reader has
+  // fallen further behind; waiting and errors as GrabNewerThan. How a stream
+  // that asked for every frame catches up after a slow detection.
+  virtual absl::StatusOr<Frame> GrabAfter(uint64_t last_id, absl::Duration timeout) = 0;
 
   virtual SourceStatus state() const = 0;
 

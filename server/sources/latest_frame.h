@@ -1,12 +1,13 @@
-// What every frame source shares: the newest frame and the source's state,
-// guarded for the source's own thread (which publishes) and any number of
-// readers (which wait for a frame newer than the last they saw). Keeping
-// only the newest frame is what makes a slow reader skip frames instead of
-// falling behind.
+// What every frame source shares: its newest frames and its state, guarded
+// for the source's own thread (which publishes) and any number of readers
+// (which wait for a frame newer than the last they saw). Keeping only the
+// last kKeptFrames is what makes a slow reader skip frames instead of
+// falling ever further behind.
 #pragma once
 
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -28,6 +29,8 @@ class LatestFrame {
   // was stopped, or had no newer frame in time; OUT_OF_RANGE when it
   // finished with no newer frame.
   absl::StatusOr<Frame> GrabNewerThan(uint64_t last_id, absl::Duration timeout) const;
+  // FrameSource::GrabAfter.
+  absl::StatusOr<Frame> GrabAfter(uint64_t last_id, absl::Duration timeout) const;
   SourceStatus state() const;
 
   // The source's thread: a new frame (the source is then RUNNING), or a new
@@ -45,9 +48,12 @@ class LatestFrame {
   const std::string label_;
   mutable std::mutex mutex_;
   mutable std::condition_variable changed_;
-  std::optional<Frame> newest_;  // guarded by mutex_
-  SourceStatus status_;          // guarded by mutex_
-  bool stopping_ = false;        // guarded by mutex_
+  // Grabs the newest frame, or with `next` the oldest kept after last_id.
+  absl::StatusOr<Frame> Grab(uint64_t last_id, absl::Duration timeout, bool next) const;
+
+  std::deque<Frame> kept_;  // oldest first, at most kKeptFrames; guarded by mutex_
+  SourceStatus status_;     // guarded by mutex_
+  bool stopping_ = false;   // guarded by mutex_
 };
 
 }  // namespace cornerpose::server

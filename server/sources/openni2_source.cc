@@ -130,6 +130,10 @@ absl::StatusOr<Frame> OpenNi2Source::GrabNewerThan(uint64_t last_id, absl::Durat
   return frames_.GrabNewerThan(last_id, timeout);
 }
 
+absl::StatusOr<Frame> OpenNi2Source::GrabAfter(uint64_t last_id, absl::Duration timeout) {
+  return frames_.GrabAfter(last_id, timeout);
+}
+
 SourceStatus OpenNi2Source::state() const { return frames_.state(); }
 
 void OpenNi2Source::Publish(Frame frame) {

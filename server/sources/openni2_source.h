@@ -55,6 +55,7 @@ class OpenNi2Source final : public FrameSource {
   // "openni2:URI" or "oni:FILE".
   std::string description() const override;
   absl::StatusOr<Frame> GrabNewerThan(uint64_t last_id, absl::Duration timeout) override;
+  absl::StatusOr<Frame> GrabAfter(uint64_t last_id, absl::Duration timeout) override;
   SourceStatus state() const override;
   // A device (the virtual camera included: it renders the world as it is);
   // an .oni recording is a replay.

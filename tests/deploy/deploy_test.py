@@ -448,8 +448,11 @@ class KubernetesTest(DeployTestCase):
         # Memory follows the admission limits (see deployment.yaml).
         field = lambda name, default: int(textproto_field(text, name) or default)
         mib = lambda q: int(str(q)[:-2]) * (1024 if str(q).endswith("Gi") else 1)
+        # A source keeps its last 6 frames (FrameSource::GrabAfter): 30 MiB of VGA.
+        sources = text.count("sources {")
         need = (128 + (2 * concurrent + field("max_queued_detections", 8)) *
-                field("max_message_bytes", 67108864) / 2**20 + field("max_streams", 16) * 8)
+                field("max_message_bytes", 67108864) / 2**20 + field("max_streams", 16) * 8 +
+                sources * 30)
         self.assertGreaterEqual(mib(res["limits"]["memory"]), need)
 
     def test_tls_and_reflection_off(self):

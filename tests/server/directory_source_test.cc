@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "common/io/cloud_io.h"
 #include "common/io/png_io.h"
 #include "server/sources/source_spec.h"
@@ -73,6 +74,42 @@ class DirectorySourceTest : public ::testing::Test {
 
   fs::path dir_;
 };
+
+// A reader a few frames behind gets every frame in order (GrabAfter); one
+// whose next frame is no longer kept skips to the newest, as GrabNewerThan
+// always does.
+TEST_F(DirectorySourceTest, GrabAfterCatchesUpInOrderWhileFramesAreKept) {
+  for (int i = 0; i < 12; ++i) WritePcd(absl::StrCat("frame_", 10 + i, ".pcd"), 10 + i);
+  DirectorySource source("bin", dir_.string(), {.fps = 100, .loop = false});
+  // Played once through: the last kKeptFrames are kept.
+  const absl::Time give_up = absl::Now() + kWait;
+  while (source.state().state != SourceState::kFinished && absl::Now() < give_up) {
+    absl::SleepFor(absl::Milliseconds(5));
+  }
+  ASSERT_EQ(source.state().state, SourceState::kFinished);
+  absl::StatusOr<Frame> newest = source.Grab(kWait);
+  ASSERT_TRUE(newest.ok()) << newest.status();
+  const uint64_t last = newest->id;
+  ASSERT_GT(last, static_cast<uint64_t>(kKeptFrames + 2));
+  // Behind by all the kept frames: each in turn.
+  uint64_t id = last - kKeptFrames;
+  for (int i = 0; i < kKeptFrames; ++i) {
+    absl::StatusOr<Frame> next = source.GrabAfter(id, kWait);
+    ASSERT_TRUE(next.ok()) << next.status();
+    EXPECT_EQ(next->id, id + 1);
+    EXPECT_EQ(next->cloud.size(), newest->cloud.size() - (last - next->id));
+    id = next->id;
+  }
+  EXPECT_EQ(source.GrabAfter(id, absl::Milliseconds(50)).status().code(),
+            absl::StatusCode::kOutOfRange);
+  // Further behind: the newest.
+  absl::StatusOr<Frame> skipped = source.GrabAfter(last - kKeptFrames - 1, kWait);
+  ASSERT_TRUE(skipped.ok()) << skipped.status();
+  EXPECT_EQ(skipped->id, last);
+  absl::StatusOr<Frame> newer = source.GrabNewerThan(last - 3, kWait);
+  ASSERT_TRUE(newer.ok()) << newer.status();
+  EXPECT_EQ(newer->id, last);
+}
 
 TEST_F(DirectorySourceTest, ReplaysOnceInNameOrderThenFinishes) {
   WriteThreePcds();

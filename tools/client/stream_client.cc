@@ -30,6 +30,9 @@ constexpr char kHelp[] =
     "Prints the detection on every new frame of the server's source NAME until\n"
     "--frames have arrived, the source ends, or the command is interrupted.\n"
     "A slow client gets the newest frame, never a backlog (frame ids then skip).\n"
+    "A frame showing the same scene as the last one detected on carries that\n"
+    "detection (\"carried from frame N\"; the server's carry_unchanged_frames).\n"
+    "Ends with a count of frames received, carried and skipped.\n"
     "\n"
     "  --server ADDR        host:port of a cornerpose server (cornerpose_server)\n"
     "  --source NAME        one of the server's sources (`cornerpose client sources`)\n"
@@ -37,6 +40,8 @@ constexpr char kHelp[] =
     "                       carton_sq, carton_flat\n"
     "  --frames N           stop after N frames (default: run until interrupted)\n"
     "  --deadline_ms N      the first frame must arrive within N ms (10000)\n"
+    "  --every_frame        every frame in order while at most a few frames behind\n"
+    "                       (catching up after a slow detection) instead of the newest\n"
     "outputs, each a DIRECTORY receiving one file per frame, <source>_<frame id>.<ext>:\n"
     "  --json DIR           boxes, edges, corners and per-stage timings\n"
     "  --ply DIR            coloured cloud with edge points, segments, boxes, corners\n"
@@ -75,8 +80,10 @@ absl::Status Stream(const CommandArgs& args) {
   SetBoxSize(*common, &request);
   request.set_include_edge_points(common->outputs.need_edge_points());
   request.set_include_cloud(common->outputs.need_cloud());
+  request.set_every_frame(args.Has("every_frame"));
 
-  absl::StatusOr<std::shared_ptr<grpc::Channel>> made = MakeChannel(common->server, TlsFilesFromArgs(args));
+  absl::StatusOr<std::shared_ptr<grpc::Channel>> made =
+      MakeChannel(common->server, TlsFilesFromArgs(args));
   if (!made.ok()) return made.status();
   std::shared_ptr<grpc::Channel> channel = *std::move(made);
   // Fail fast when the server is not there; the stream itself has no deadline.
@@ -90,9 +97,22 @@ absl::Status Stream(const CommandArgs& args) {
   std::unique_ptr<grpc::ClientReader<v1::DetectResponse>> reader =
       stub->StreamDetections(&context, request);
   v1::DetectResponse response;
-  int frames = 0;
+  int frames = 0, carried = 0;
+  uint64_t first_id = 0, last_id = 0;
+  const auto summary = [&] {
+    if (args.Has("quiet") || frames == 0) return;
+    std::printf(
+        "%d frames received (ids %llu-%llu, %llu skipped), %d carried from an earlier one\n",
+        frames, static_cast<unsigned long long>(first_id), static_cast<unsigned long long>(last_id),
+        static_cast<unsigned long long>(last_id - first_id + 1 - frames), carried);
+  };
   while (reader->Read(&response)) {
     ++frames;
+    if (first_id == 0) first_id = response.frame_id();
+    last_id = response.frame_id();
+    const bool was_carried =
+        response.detected_frame_id() != 0 && response.detected_frame_id() != response.frame_id();
+    carried += was_carried;
     absl::StatusOr<Detection> det = wire::DetectionFromProto(response);
     if (!det.ok()) {
       context.TryCancel();
@@ -106,9 +126,12 @@ absl::Status Stream(const CommandArgs& args) {
           absl::StrCat("bad cloud from ", common->server, ": ", cloud.status().message()));
     }
     if (!args.Has("quiet")) {
-      PrintDetection(absl::StrCat(response.source(), " frame ", response.frame_id()),
-                     response.has_cloud() ? std::optional<size_t>(cloud->size()) : std::nullopt,
-                     *det);
+      PrintDetection(
+          absl::StrCat(
+              response.source(), " frame ", response.frame_id(),
+              was_carried ? absl::StrCat(" (carried from frame ", response.detected_frame_id(), ")")
+                          : std::string()),
+          response.has_cloud() ? std::optional<size_t>(cloud->size()) : std::nullopt, *det);
       std::fflush(stdout);
     }
     OutputPaths paths;
@@ -126,6 +149,7 @@ absl::Status Stream(const CommandArgs& args) {
       break;
     }
   }
+  summary();
   const grpc::Status end = reader->Finish();
   // Cancelled by us after --frames; a source that played once ends with OK.
   if (max_frames > 0 && frames >= max_frames) return absl::OkStatus();
@@ -136,11 +160,11 @@ absl::Status Stream(const CommandArgs& args) {
 
 int RunClientStream(const std::vector<std::string>& argv) {
   if (PrintHelpIfAsked(argv, HelpWithTls(kHelp).c_str())) return 0;
-  absl::StatusOr<CommandArgs> args = ParseCommandArgs(
-      argv,
-      WithTlsOptions(
-          {"server", "source", "box", "frames", "json", "ply", "png", "edges", "deadline_ms"}),
-      {"quiet"}, {"server", "source", "box"});
+  absl::StatusOr<CommandArgs> args =
+      ParseCommandArgs(argv,
+                       WithTlsOptions({"server", "source", "box", "frames", "json", "ply", "png",
+                                       "edges", "deadline_ms"}),
+                       {"quiet", "every_frame"}, {"server", "source", "box"});
   if (!args.ok()) return ReportUsageError("stream", args.status(), HelpWithTls(kHelp).c_str());
   return ReportClientResult("stream", Stream(*args));
 }
