@@ -31,6 +31,9 @@ absl::Status FrameChangeOptions::Validate() const {
 
 namespace {
 
+// Depths beyond this are no return (and keep the sums finite). Metres.
+constexpr float kFarthest = 1000.0f;
+
 // One row of blocks: per block, the count and sum of its valid depths.
 struct BlockRow {
   std::vector<int> count;
@@ -52,7 +55,7 @@ void SumBlockRow(const PointCloud& cloud, int by, int block, BlockRow* row) {
       int n = 0;
       for (int x = bx * block; x < x_end; ++x) {
         const float z = p[x].z();
-        if (std::isfinite(z) && z > 0.0f) {
+        if (z > 0.0f && z < kFarthest) {  // false for NaN
           s += z;
           ++n;
         }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <iostream>
+#include <limits>
 #include <string>
 
 #include "common/perception/detector.h"
@@ -117,6 +118,31 @@ TEST(FrameChangeTest, CloudsWithoutPixelsToCompareAreNotTheSameScene) {
   EXPECT_TRUE(itself->same_scene);
   EXPECT_EQ(itself->compared_blocks, 4);
   EXPECT_EQ(itself->changed_blocks, 0);
+}
+
+// NaN, infinite, negative and absurd depths are no return: the sums stay
+// finite, and a block that lost its returns to them has changed.
+TEST(FrameChangeTest, BadDepthsAreNoReturn) {
+  PointCloud a;
+  a.width = 64;
+  a.height = 64;
+  a.xyz.assign(64 * 64, Eigen::Vector3f(0, 0, 1.5f));
+  PointCloud b = a;
+  const float bad[] = {std::numeric_limits<float>::quiet_NaN(),
+                       std::numeric_limits<float>::infinity(), -1.0f, 1e30f};
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) b.xyz[y * 64 + x].z() = bad[(x + y) % 4];
+  }
+  FrameChangeOptions o;
+  o.max_changed_blocks = 0;
+  absl::StatusOr<FrameChange> change = CompareFrames(a, b, o);
+  ASSERT_TRUE(change.ok());
+  EXPECT_FALSE(change->same_scene);
+  EXPECT_EQ(change->compared_blocks, 64);
+  absl::StatusOr<FrameChange> itself = CompareFrames(b, b, o);
+  ASSERT_TRUE(itself.ok());
+  EXPECT_TRUE(itself->same_scene);
+  EXPECT_EQ(itself->compared_blocks, 48);  // the bad quarter has no returns
 }
 
 // A carton or a brick taken away is a change on every sensor model, in

@@ -12,6 +12,7 @@
 // several seeds), each detected once per iteration; its counters are the
 // median and p90 of the detector's own reported time per frame and the
 // correct / pickable boxes over the set.
+// BM_CompareFrames: a stream's test for an unchanged frame (frame_change.h).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -25,6 +26,7 @@
 #include "common/box/box_models.h"
 #include "common/io/cloud_io.h"
 #include "common/perception/detector.h"
+#include "common/perception/frame_change.h"
 #include "common/perception/pose_error.h"
 #include "tests/support/scene_generator.h"
 #include "tests/support/scene_kinds.h"
@@ -244,6 +246,30 @@ BENCHMARK(BM_ClutterSet)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(3.0);
+
+// What a stream pays to tell whether a frame shows the same scene as the one
+// it last detected on (CompareFrames, the windows sized for the box): the
+// benchmark frame against itself rendered with new noise.
+void BM_CompareFrames(benchmark::State& state) {
+  const BoxDims dims{0.30, 0.20, 0.15};
+  testing::Scene scene = testing::MakeHeapScene(dims, 12, 7);
+  const PointCloud before = testing::Render(scene).cloud;
+  scene.look_seed = scene.LookSeed();
+  scene.noise_seed += 1000;
+  const PointCloud after = testing::Render(scene).cloud;
+  FrameChangeOptions o;
+  o.box_side_m = dims.h;
+  o.focal_px = scene.camera.fx;
+  int same = 0;
+  for (auto _ : state) {
+    absl::StatusOr<FrameChange> change = CompareFrames(before, after, o);
+    same += change.ok() && change->same_scene;
+    benchmark::DoNotOptimize(change);
+  }
+  state.counters["same_scene"] =
+      static_cast<double>(same) / std::max<int64_t>(1, state.iterations());
+}
+BENCHMARK(BM_CompareFrames)->Unit(benchmark::kMillisecond);
 
 // How soon a cancelled detection returns: each clutter frame is detected
 // and cancelled from another thread after a delay spread over the frame's
