@@ -105,6 +105,9 @@ constexpr char kHelp[] =
     "                       corners (false)\n"
     "  --border_faces BOOL  a planar patch at the image border no bigger than a face\n"
     "                       proposes that face (true)\n"
+    "  --leaving_view N     a face the image border cuts is returned when free sides or\n"
+    "                       seams end it all round, with a free side on N of its two\n"
+    "                       axes (1; 2: on both; 0: seams suffice)\n"
     "  --retry_declined BOOL a pose refined and declined is judged once more when\n"
     "                       proposed again from another start (true)\n"
     "  --patch_window N     planar patches: a cell's normal from (2N+1)^2 cells of 4 px\n"
@@ -154,6 +157,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides),
         args.SetInt("max_declined", &options.max_declined),
         args.SetBool("border_faces", &options.faces.propose_at_border),
+        args.SetInt("leaving_view", &options.acceptance.leaving_view_free_axes),
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
         args.SetDouble("end_on_flat", &options.refinement.end_on_flat_shift_m),
@@ -264,6 +268,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "max_declined",
                                                        "side_allowance",
                                                        "border_faces",
+                                                       "leaving_view",
                                                        "anchored_faces",
                                                        "rim_sides",
                                                        "end_on_flat",

@@ -50,9 +50,14 @@ struct AcceptanceOptions {
   // The grasp face must project this far inside the image. Pixels.
   double border_margin_px = 3.0;
   // ... unless every side of it was found where the face ends (free or a
-  // seam, with a free side on each axis): then a corner out of view hides
-  // nothing about where the box is. False: every face in view, whole.
+  // seam, with a free side on leaving_view_free_axes of its two axes): then
+  // a corner out of view hides nothing about where the box is. False: every
+  // face in view, whole.
   bool measured_face_may_leave_view = true;
+  // 1: one free side anywhere (a seam's turn is measured since the
+  // fourteenth round); 2: a free side on each axis (the rule before session
+  // 17); 0: seams on all four suffice. Count, [0, 2].
+  int leaving_view_free_axes = 1;
   // Two accepted boxes may not overlap by more than this (each is shrunk by
   // it before the overlap test). Metres.
   double overlap_margin_m = 0.015;

@@ -106,14 +106,14 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
 namespace {
 
 // Every side of the grasp face measured where the face ends (free or a
-// seam), with a free side on each axis (a free side's turn is surer than
-// a seam's, which a short side does not give at all): the face is pinned
-// down though a corner of it lies out of view.
-bool PinnedOnEverySide(const std::array<SideKind, 4>& sides) {
+// seam), with a free side on `free_axes` of its two axes (a free side is
+// surer than a seam): the face is pinned down though a corner of it lies out
+// of view.
+bool PinnedOnEverySide(const std::array<SideKind, 4>& sides, int free_axes) {
   auto ends = [](SideKind k) { return k == SideKind::kFree || k == SideKind::kSeam; };
-  return std::all_of(sides.begin(), sides.end(), ends) &&
-         (sides[0] == SideKind::kFree || sides[1] == SideKind::kFree) &&
-         (sides[2] == SideKind::kFree || sides[3] == SideKind::kFree);
+  const int axes = (sides[0] == SideKind::kFree || sides[1] == SideKind::kFree) +
+                   (sides[2] == SideKind::kFree || sides[3] == SideKind::kFree);
+  return std::all_of(sides.begin(), sides.end(), ends) && axes >= free_axes;
 }
 
 }  // namespace
@@ -271,7 +271,7 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   if (score < 0.0) return false;
   if (!GraspFaceInView(cand.box.camera_T_box, grasp, options_.acceptance.border_margin_px) &&
       !(options_.acceptance.measured_face_may_leave_view &&
-        PinnedOnEverySide(cand.refinement.sides))) {
+        PinnedOnEverySide(cand.refinement.sides, options_.acceptance.leaving_view_free_axes))) {
     *reason = "grasp face cut by the image border";
     return false;
   }
