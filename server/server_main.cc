@@ -80,8 +80,8 @@ ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
 ABSL_FLAG(std::string, tls_client_ca, "",
           "PEM CA bundle; when set, clients must present a certificate it signed (mutual TLS)");
 ABSL_FLAG(bool, carry_unchanged_frames, cornerpose::server::ServerOptions{}.carry_unchanged_frames,
-          "streams: a frame showing the same scene as the last one detected on gets its "
-          "detection without a detector run");
+          "streams and Detect on a source: a frame showing the same scene as the last one "
+          "detected on gets its detection without a detector run");
 ABSL_FLAG(bool, reflection, cornerpose::server::ServerOptions{}.enable_reflection,
           "serve gRPC reflection (off in production)");
 ABSL_FLAG(std::vector<std::string>, source, {},

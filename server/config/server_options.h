@@ -88,9 +88,9 @@ struct ServerOptions {
   std::string tls_client_ca{};
   // gRPC server reflection (grpcurl without the protos). Off in production.
   bool enable_reflection = true;
-  // StreamDetections: a frame showing the same scene as the last frame
-  // detected on (CompareFrames) gets that detection without a detector run
-  // (README, "Streams").
+  // StreamDetections and Detect on a source: a frame showing the same scene
+  // as the last frame detected on (CompareFrames) gets that detection
+  // without a detector run (README, "Streams that keep up").
   bool carry_unchanged_frames = true;
 
   // The detector options every request starts from (its box is unused: a

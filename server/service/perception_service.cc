@@ -76,12 +76,15 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, absl::Time deadline
                        const v1::DetectRequest& request, const DetectorOptions& defaults,
                        const BoxModels& box_models,
                        const std::map<std::string, std::unique_ptr<FrameSource>>& sources,
-                       v1::DetectResponse& response) {
+                       CarriedDetections& carried, v1::DetectResponse& response) {
   if (grpc::Status s = CheckStillWanted(context, deadline); !s.ok()) return s;
   absl::StatusOr<DetectorOptions> options =
       DetectorOptionsFromRequest(request, defaults, box_models);
   if (!options.ok()) return ToGrpcStatus(options.status());
-  std::optional<Frame> frame;
+  std::shared_ptr<const Frame> frame;
+  std::string carry_key;  // the source and the parameters that change the detection
+  const ResponseContents contents{.include_edge_points = request.include_edge_points(),
+                                  .include_cloud = request.include_cloud()};
   absl::StatusOr<PointCloud> sent;
   const PointCloud* cloud = nullptr;
   if (request.input_case() == v1::DetectRequest::kSource) {
@@ -92,10 +95,21 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, absl::Time deadline
     }
     absl::StatusOr<Frame> grabbed = GrabFromSource(sources, request.source(), deadline);
     if (!grabbed.ok()) return ToGrpcStatus(grabbed.status());
-    frame = *std::move(grabbed);
+    frame = std::make_shared<const Frame>(*std::move(grabbed));
     cloud = &frame->cloud;
     // The source knows its camera; the request's intrinsics do not apply.
     UseFrameCamera(frame->camera, &*options);
+    // The same scene as the last call's frame: its detection, at once.
+    v1::DetectRequest parameters = request;
+    parameters.clear_include_edge_points();
+    parameters.clear_include_cloud();
+    carry_key = parameters.SerializeAsString();
+    if (std::optional<CarriedDetections::Carried> c = carried.Find(carry_key, *frame, *options)) {
+      if (grpc::Status s = CheckStillWanted(context, deadline); !s.ok()) return s;
+      response = MakeDetectResponse(c->detection, *options, frame.get(), contents);
+      response.set_detected_frame_id(c->frame_id);
+      return grpc::Status::OK;
+    }
   } else {
     sent = CloudFromRequest(request);
     if (!sent.ok()) return ToGrpcStatus(sent.status());
@@ -108,11 +122,10 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, absl::Time deadline
   const CancelToken cancel(deadline, [&context] { return context.IsCancelled(); });
   absl::StatusOr<Detection> detection = DetectBoxes(*cloud, *options, cancel);
   if (!detection.ok()) return ToGrpcStatus(detection.status());
+  if (frame != nullptr) carried.Store(carry_key, frame, *detection);
 
   if (grpc::Status s = CheckStillWanted(context, deadline); !s.ok()) return s;
-  response = MakeDetectResponse(*detection, *options, frame ? &*frame : nullptr,
-                                {.include_edge_points = request.include_edge_points(),
-                                 .include_cloud = request.include_cloud()});
+  response = MakeDetectResponse(*detection, *options, frame.get(), contents);
   return grpc::Status::OK;
 }
 
@@ -125,7 +138,8 @@ PerceptionServiceImpl::PerceptionServiceImpl(DetectionPool* pool, const Detector
       defaults_(defaults),
       box_models_(std::move(box_models)),
       limits_(limits),
-      shared_(limits.carry_unchanged_frames) {
+      shared_(limits.carry_unchanged_frames),
+      carried_(limits.carry_unchanged_frames) {
   for (std::unique_ptr<FrameSource>& source : sources) {
     const std::string name = source->name();
     sources_.emplace(name, std::move(source));
@@ -147,8 +161,8 @@ grpc::ServerUnaryReactor* PerceptionServiceImpl::Detect(grpc::CallbackServerCont
   const absl::Time deadline = EffectiveDeadline(*context, limits_);
   // context, request and response stay valid until Finish.
   const bool queued = pool_->TrySubmit([this, context, deadline, request, response, reactor] {
-    reactor->Finish(
-        RunDetect(*context, deadline, *request, defaults_, box_models_, sources_, *response));
+    reactor->Finish(RunDetect(*context, deadline, *request, defaults_, box_models_, sources_,
+                              carried_, *response));
   });
   if (!queued) {
     // Refused at once, so a client can back off or try another replica.

@@ -12,6 +12,7 @@
 #include "absl/time/time.h"
 #include "common/perception/detector.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
+#include "server/service/carried_detections.h"
 #include "server/service/detect_request.h"
 #include "server/service/detection_pool.h"
 #include "server/service/shared_detections.h"
@@ -66,6 +67,8 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
   // not counted), frames carried, and streams open.
   uint64_t stream_detections_started() const { return shared_.started(); }
   uint64_t stream_frames_carried() const { return shared_.carried(); }
+  // Detect calls on a source answered with an earlier frame's detection.
+  uint64_t detect_calls_carried() const { return carried_.carried(); }
   int open_streams() const { return open_streams_.load(); }
 
  private:
@@ -76,6 +79,8 @@ class PerceptionServiceImpl final : public v1::PerceptionService::CallbackServic
   std::map<std::string, std::unique_ptr<FrameSource>> sources_;
   const ServiceLimits limits_;
   SharedDetections shared_;
+  // Detect on a source: the last detection per source and parameters.
+  CarriedDetections carried_;
   std::atomic<bool> stopping_streams_{false};
   std::atomic<int> open_streams_{0};
 };

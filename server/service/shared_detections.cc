@@ -1,12 +1,10 @@
 #include "server/service/shared_detections.h"
 
-#include <algorithm>
 #include <chrono>
 #include <iterator>
 #include <utility>
 
-#include "common/perception/camera_model.h"
-#include "common/perception/frame_change.h"
+#include "server/service/carried_detections.h"
 
 namespace cornerpose::server {
 
@@ -72,15 +70,7 @@ std::shared_ptr<const SharedDetection> SharedDetections::Carrier(
       !detected->result.get().ok()) {
     return nullptr;
   }
-  FrameChangeOptions compare;
-  compare.box_side_m = std::min({options.box.l, options.box.b, options.box.h});
-  if (options.camera) {
-    compare.focal_px = options.camera->fx;
-  } else if (absl::StatusOr<CameraIntrinsics> k = EstimateIntrinsics(frame.cloud); k.ok()) {
-    compare.focal_px = k->fx;
-  }
-  absl::StatusOr<FrameChange> change = CompareFrames(detected->frame->cloud, frame.cloud, compare);
-  return change.ok() && change->same_scene ? detected : nullptr;
+  return ShowsSameScene(*detected->frame, frame, options) ? detected : nullptr;
 }
 
 uint64_t SharedDetections::started() const {

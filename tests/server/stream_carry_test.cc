@@ -1,8 +1,9 @@
 // Carrying a detection across unchanged frames (ServerOptions::
-// carry_unchanged_frames), through the real server on 127.0.0.1:0 and a real
-// stream: a recording of a pallet, five frames with new sensor noise, then
-// five with its top box taken. A frame of the same scene gets the detection
-// of the frame detected on; no frame after the take gets one from before it.
+// carry_unchanged_frames), through the real server on 127.0.0.1:0, real
+// streams and real Detect calls: a recording of a pallet, five frames with
+// new sensor noise, then five with its top box taken. A frame of the same
+// scene gets the detection of the frame detected on; no frame after the
+// take gets one from before it.
 #include <grpcpp/create_channel.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -15,6 +16,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "absl/strings/str_format.h"
@@ -31,8 +33,9 @@ namespace fs = std::filesystem;
 constexpr BoxDims kCarton{0.30, 0.20, 0.15};  // carton_s
 constexpr int kPerState = 5;                  // frames before and after the take
 
-// Writes the recording: rec_0000 .. rec_0009 and intrinsics.txt.
-void WriteRecording(const fs::path& dir) {
+// Writes the recording: rec_0000 .. rec_0009 and intrinsics.txt; with
+// `same_scene_only` the first five only.
+void WriteRecording(const fs::path& dir, bool same_scene_only = false) {
   fs::create_directories(dir);
   std::string type;
   absl::StatusOr<testing::Scene> scene =
@@ -40,7 +43,7 @@ void WriteRecording(const fs::path& dir) {
   ASSERT_TRUE(scene.ok()) << scene.status();
   scene->look_seed = scene->LookSeed();
   const uint32_t noise = scene->noise_seed;
-  for (int i = 0; i < 2 * kPerState; ++i) {
+  for (int i = 0; i < (same_scene_only ? 1 : 2) * kPerState; ++i) {
     testing::Scene frame = *scene;
     frame.noise_seed = noise + i;
     if (i >= kPerState) {
@@ -77,10 +80,14 @@ class StreamCarryTest : public ::testing::Test {
     dir_ = new fs::path(fs::temp_directory_path() /
                         ("cornerpose_carry_" + std::to_string(::getpid())));
     WriteRecording(*dir_);
+    still_ = new fs::path(dir_->string() + "_still");
+    WriteRecording(*still_, /*same_scene_only=*/true);
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);
+    fs::remove_all(*still_);
     delete dir_;
+    delete still_;
   }
 
   // Streams the recording once at `fps` and returns every response by
@@ -122,8 +129,65 @@ class StreamCarryTest : public ::testing::Test {
   }
 
   static fs::path* dir_;
+  static fs::path* still_;  // the pallet alone, five frames
 };
 fs::path* StreamCarryTest::dir_ = nullptr;
+fs::path* StreamCarryTest::still_ = nullptr;
+
+// Detect on a source that shows the same pallet call after call (new noise
+// on every frame, the recording looping at 20 fps): the first call detects,
+// the next ones carry its detection, newer frames with its boxes; with
+// carry off every call detects.
+TEST_F(StreamCarryTest, DetectOnASourceCarriesTheLastDetectionOfTheSameScene) {
+  for (const bool carry : {true, false}) {
+    SCOPED_TRACE(::testing::Message() << "carry " << carry);
+    ServerOptions options;
+    options.listen_address = "127.0.0.1:0";
+    options.carry_unchanged_frames = carry;
+    SourceSpec source;
+    source.name = "still";
+    source.directory = still_->string();
+    source.fps = 20;
+    options.sources.push_back(source);
+    absl::StatusOr<std::unique_ptr<RunningServer>> server = StartServer(options);
+    ASSERT_TRUE(server.ok()) << server.status();
+    auto stub = v1::PerceptionService::NewStub(grpc::CreateChannel(
+        "127.0.0.1:" + std::to_string((*server)->port()), grpc::InsecureChannelCredentials()));
+    std::vector<v1::DetectResponse> responses;
+    uint64_t last_frame = 0;
+    for (int call = 0; call < 4; ++call) {
+      v1::DetectRequest request;
+      request.set_source("still");
+      request.set_box_model("carton_s");
+      request.set_include_edge_points(call % 2 == 1);  // what a response carries: still carried
+      grpc::ClientContext context;
+      context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+      v1::DetectResponse r;
+      const grpc::Status s = stub->Detect(&context, request, &r);
+      ASSERT_TRUE(s.ok()) << s.error_message();
+      EXPECT_GT(r.frame_id(), last_frame) << "call " << call;
+      last_frame = r.frame_id();
+      responses.push_back(r);
+      std::this_thread::sleep_for(std::chrono::milliseconds(120));  // a newer frame
+    }
+    EXPECT_EQ(responses[0].detected_frame_id(), responses[0].frame_id());
+    EXPECT_GT(responses[0].boxes_size(), 0);
+    for (size_t i = 1; i < responses.size(); ++i) {
+      const v1::DetectResponse& r = responses[i];
+      if (!carry) {
+        EXPECT_EQ(r.detected_frame_id(), r.frame_id());
+        continue;
+      }
+      EXPECT_EQ(r.detected_frame_id(), responses[0].frame_id()) << "call " << i;
+      ASSERT_EQ(r.boxes_size(), responses[0].boxes_size());
+      for (int b = 0; b < r.boxes_size(); ++b) {
+        EXPECT_EQ(r.boxes(b).SerializeAsString(), responses[0].boxes(b).SerializeAsString());
+      }
+      EXPECT_EQ(r.edge_points_size() > 0, i % 2 == 1);
+    }
+    EXPECT_EQ((*server)->service().detect_calls_carried(), carry ? 3u : 0u);
+  }
+}
 
 TEST_F(StreamCarryTest, UnchangedFramesCarryTheDetectionAndATakenBoxEndsIt) {
   uint64_t carried = 0;
