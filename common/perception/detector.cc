@@ -156,6 +156,12 @@ bool CheckStandsLevel(const DetectorOptions& options, std::vector<DetectedBox>* 
     const int n = static_cast<int>(b.grasp_face) / 2;
     return 0.5 * std::hypot(d[(n + 1) % 3], d[(n + 2) % 3]);
   };
+  // A box read on a smaller face than the one it sits on (an end face
+  // inside a carton's top) lies farther from that carton's neighbours than
+  // its own face says: its neighbours are sought as far as the largest face
+  // would reach.
+  const double largest_half_diagonal =
+      0.5 * std::max({std::hypot(d.l, d.b), std::hypot(d.l, d.h), std::hypot(d.b, d.h)});
   const double cos_parallel = std::cos(12.0 * M_PI / 180.0);
   return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
     const DetectedBox& b = (*boxes)[i];
@@ -169,7 +175,9 @@ bool CheckStandsLevel(const DetectorOptions& options, std::vector<DetectedBox>* 
       const Eigen::Vector3d offset = b.grasp_centre_camera - nb.grasp_centre_camera;
       const double above = offset.dot(n);  // b's top above its neighbour's
       const double apart = (offset - above * n).norm();
-      if (std::abs(above) > tol || apart > 1.15 * (half_diagonal(b) + half_diagonal(nb))) continue;
+      if (std::abs(above) > tol || apart > 1.15 * (largest_half_diagonal + half_diagonal(nb))) {
+        continue;
+      }
       const double below = height(b) - above - height(nb);  // b's bottom below nb's
       if (below <= tol) continue;
       ++level;

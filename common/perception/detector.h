@@ -93,8 +93,9 @@ struct DetectorOptions {
   double floor_tolerance_m = 0.03;
   double floor_min_area_m2 = 0.25;
   // With face proposals: a box whose top lies level (within this) with two
-  // or more boxes found beside it (grasp faces parallel and touching: a
-  // layer around it) but whose bottom would lie more than this below
+  // or more boxes found beside it (grasp faces parallel and touching, as
+  // far as the box's largest face would reach: a layer around it) but
+  // whose bottom would lie more than this below
   // theirs is taken out: it would stand in a hole in what they stand on.
   // What it is: a box of another size whose top matches one of the box's
   // faces (a smaller box in a layer of flat cartons read as a carton on
