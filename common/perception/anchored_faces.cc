@@ -5,36 +5,10 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/perception/face_proposals.h"
+#include "common/perception/internal/summed_area.h"
 
 namespace cornerpose {
 namespace {
-
-// Counts over axis-aligned cell rectangles in O(1): a summed-area table.
-class CellSums {
- public:
-  CellSums(const std::vector<uint8_t>& cells, int w, int h)
-      : w_(w), h_(h), sum_(static_cast<size_t>(w + 1) * (h + 1), 0) {
-    for (int j = 0; j < h; ++j) {
-      int row = 0;
-      for (int i = 0; i < w; ++i) {
-        row += cells[static_cast<size_t>(j) * w + i];
-        sum_[At(i + 1, j + 1)] = sum_[At(i + 1, j)] + row;
-      }
-    }
-  }
-  // Cells set in [i0, i1) x [j0, j1), clipped to the grid.
-  int Count(int i0, int j0, int i1, int j1) const {
-    i0 = std::clamp(i0, 0, w_), i1 = std::clamp(i1, 0, w_);
-    j0 = std::clamp(j0, 0, h_), j1 = std::clamp(j1, 0, h_);
-    if (i1 <= i0 || j1 <= j0) return 0;
-    return sum_[At(i1, j1)] - sum_[At(i0, j1)] - sum_[At(i1, j0)] + sum_[At(i0, j0)];
-  }
-
- private:
-  size_t At(int i, int j) const { return static_cast<size_t>(j) * (w_ + 1) + i; }
-  int w_, h_;
-  std::vector<int> sum_;
-};
 
 struct Anchored {
   double score;
@@ -125,7 +99,7 @@ std::vector<Eigen::Isometry3d> AnchoredFaces(const PlanarPatch& patch, const Pla
       unseen[static_cast<size_t>(j) * w + i] = !seen;
     }
   }
-  const CellSums on_sum(on, w, h), unseen_sum(unseen, w, h);
+  const internal::SummedArea<int> on_sum(on, w, h), unseen_sum(unseen, w, h);
 
   // The faces of the box, each size once: (normal axis, axis along u, along v).
   struct Shape {
@@ -153,7 +127,7 @@ std::vector<Eigen::Isometry3d> AnchoredFaces(const PlanarPatch& patch, const Pla
         for (int j0 = 0; j0 + b <= h; ++j0) {
           for (int i0 = 0; i0 + a <= w; ++i0) {
             const int i1 = i0 + a, j1 = j0 + b;
-            const double inside = on_sum.Count(i0, j0, i1, j1) / static_cast<double>(a * b);
+            const double inside = on_sum.Sum(i0, j0, i1, j1) / static_cast<double>(a * b);
             if (inside < o.min_inside) continue;
             // The anchored side across u (at i1 when du = 1, at i0 when -1),
             // its inner edge and what lies beyond, over the half of it at the
@@ -164,14 +138,14 @@ std::vector<Eigen::Isometry3d> AnchoredFaces(const PlanarPatch& patch, const Pla
             const int hj0 = dv > 0 ? j1 - b / 2 : j0, hj1 = dv > 0 ? j1 : j0 + b / 2;
             const int hi0 = du > 0 ? i1 - a / 2 : i0, hi1 = du > 0 ? i1 : i0 + a / 2;
             const double side_u = kBeyond * (hj1 - hj0), side_v = kBeyond * (hi1 - hi0);
-            const double edge_u = on_sum.Count(ui, hj0, ui + kBeyond, hj1) / side_u;
-            const double edge_v = on_sum.Count(hi0, vj, hi1, vj + kBeyond) / side_v;
+            const double edge_u = on_sum.Sum(ui, hj0, ui + kBeyond, hj1) / side_u;
+            const double edge_v = on_sum.Sum(hi0, vj, hi1, vj + kBeyond) / side_v;
             if (edge_u < o.min_edge || edge_v < o.min_edge) continue;
-            const double beyond_u = on_sum.Count(ub, hj0, ub + kBeyond, hj1) / side_u;
-            const double beyond_v = on_sum.Count(hi0, vb, hi1, vb + kBeyond) / side_v;
+            const double beyond_u = on_sum.Sum(ub, hj0, ub + kBeyond, hj1) / side_u;
+            const double beyond_v = on_sum.Sum(hi0, vb, hi1, vb + kBeyond) / side_v;
             if (beyond_u > o.max_beyond || beyond_v > o.max_beyond) continue;
-            if (unseen_sum.Count(ub, hj0, ub + kBeyond, hj1) > 0 ||
-                unseen_sum.Count(hi0, vb, hi1, vb + kBeyond) > 0) {
+            if (unseen_sum.Sum(ub, hj0, ub + kBeyond, hj1) > 0 ||
+                unseen_sum.Sum(hi0, vb, hi1, vb + kBeyond) > 0) {
               continue;
             }
             found.push_back({inside + 0.5 * (edge_u + edge_v) - beyond_u - beyond_v,

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "common/perception/internal/summed_area.h"
 #include "common/validation/range_check.h"
 
 namespace cornerpose {
@@ -66,30 +67,6 @@ void SumBlockRow(const PointCloud& cloud, int by, int block, BlockRow* row) {
   }
 }
 
-// Sums over rectangles of blocks in O(1).
-class BlockSums {
- public:
-  BlockSums(const std::vector<double>& v, int w, int h) : w_(w), sum_((w + 1) * (h + 1), 0.0) {
-    for (int y = 0; y < h; ++y) {
-      double row = 0.0;
-      for (int x = 0; x < w; ++x) {
-        row += v[static_cast<size_t>(y) * w + x];
-        sum_[At(x + 1, y + 1)] = sum_[At(x + 1, y)] + row;
-      }
-    }
-  }
-  // Over [x0, x1] x [y0, y1], inclusive and inside the grid.
-  double Sum(int x0, int y0, int x1, int y1) const {
-    return sum_[At(x1 + 1, y1 + 1)] - sum_[At(x0, y1 + 1)] - sum_[At(x1 + 1, y0)] +
-           sum_[At(x0, y0)];
-  }
-
- private:
-  size_t At(int x, int y) const { return static_cast<size_t>(y) * (w_ + 1) + x; }
-  int w_;
-  std::vector<double> sum_;
-};
-
 }  // namespace
 
 absl::StatusOr<FrameChange> CompareFrames(const PointCloud& before, const PointCloud& after,
@@ -131,8 +108,9 @@ absl::StatusOr<FrameChange> CompareFrames(const PointCloud& before, const PointC
   // Each block is judged by the mean change over a window around it as big
   // as the box's smallest side there: the noise (correlated over a few
   // pixels) averages out, a box taken or put down moves the whole window.
-  const BlockSums sum_compared(compared, bw, bh), sum_with_depth(with_depth, bw, bh),
-      sum_dz(dz, bw, bh), sum_z(z, bw, bh), sum_dshare(dshare, bw, bh);
+  using Sums = internal::SummedArea<double>;
+  const Sums sum_compared(compared, bw, bh), sum_with_depth(with_depth, bw, bh), sum_dz(dz, bw, bh),
+      sum_z(z, bw, bh), sum_dshare(dshare, bw, bh);
   for (int by = 0; by < bh; ++by) {
     for (int bx = 0; bx < bw; ++bx) {
       const size_t i = static_cast<size_t>(by) * bw + bx;
@@ -143,14 +121,16 @@ absl::StatusOr<FrameChange> CompareFrames(const PointCloud& before, const PointC
         const double side_px = options.focal_px * options.box_side_m / z[i];
         r = std::clamp(static_cast<int>(0.5 * side_px / block), 1, kMaxWindowBlocks);
       }
-      const int x0 = std::max(0, bx - r), x1 = std::min(bw - 1, bx + r);
-      const int y0 = std::max(0, by - r), y1 = std::min(bh - 1, by + r);
-      const double cmp = sum_compared.Sum(x0, y0, x1, y1);
-      bool moved = std::abs(sum_dshare.Sum(x0, y0, x1, y1) / cmp) > options.max_valid_share_change;
-      const double nd = sum_with_depth.Sum(x0, y0, x1, y1);
+      // The window [bx - r, bx + r] x [by - r, by + r] (the sums clip it).
+      const auto window = [&](const Sums& sums) {
+        return sums.Sum(bx - r, by - r, bx + r + 1, by + r + 1);
+      };
+      bool moved =
+          std::abs(window(sum_dshare) / window(sum_compared)) > options.max_valid_share_change;
+      const double nd = window(sum_with_depth);
       if (!moved && nd > 0.0) {
-        const double zm = sum_z.Sum(x0, y0, x1, y1) / nd;
-        moved = std::abs(sum_dz.Sum(x0, y0, x1, y1) / nd) >
+        const double zm = window(sum_z) / nd;
+        moved = std::abs(window(sum_dz) / nd) >
                 options.min_depth_change_m + options.depth_change_per_m2 * zm * zm;
       }
       change.changed_blocks += moved;

@@ -39,7 +39,7 @@ std::optional<CarriedDetections::Carried> CarriedDetections::Find(const std::str
   if (!ShowsSameScene(*before, frame, options)) return std::nullopt;
   std::lock_guard<std::mutex> lock(mutex_);
   ++carried_;
-  return Carried{*detection, before->id};
+  return Carried{std::move(detection), before->id};
 }
 
 void CarriedDetections::Store(const std::string& key, std::shared_ptr<const Frame> frame,

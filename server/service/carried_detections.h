@@ -31,7 +31,7 @@ class CarriedDetections {
       : enabled_(enabled), max_keys_(max_keys) {}
 
   struct Carried {
-    Detection detection;
+    std::shared_ptr<const Detection> detection;
     uint64_t frame_id = 0;  // the frame it ran on
   };
   // The detection stored under `key`, when `frame` shows the same scene as

@@ -106,7 +106,7 @@ grpc::Status RunDetect(grpc::CallbackServerContext& context, absl::Time deadline
     carry_key = parameters.SerializeAsString();
     if (std::optional<CarriedDetections::Carried> c = carried.Find(carry_key, *frame, *options)) {
       if (grpc::Status s = CheckStillWanted(context, deadline); !s.ok()) return s;
-      response = MakeDetectResponse(c->detection, *options, frame.get(), contents);
+      response = MakeDetectResponse(*c->detection, *options, frame.get(), contents);
       response.set_detected_frame_id(c->frame_id);
       return grpc::Status::OK;
     }

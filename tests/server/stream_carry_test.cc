@@ -90,27 +90,34 @@ class StreamCarryTest : public ::testing::Test {
     delete still_;
   }
 
-  // Streams the recording once at `fps` and returns every response by
-  // frame id.
-  std::map<uint64_t, v1::DetectResponse> StreamAll(bool carry, uint64_t* carried,
-                                                   bool every_frame = false, double fps = 10) {
+  // A server on 127.0.0.1:0 serving `dir` as the source `name`, and a stub
+  // to it; false (with a test failure) when it did not start.
+  bool Start(const std::string& name, const fs::path& dir, double fps, bool loop, bool carry) {
     ServerOptions options;
     options.listen_address = "127.0.0.1:0";
     options.carry_unchanged_frames = carry;
     SourceSpec source;
-    source.name = "rec";
-    source.directory = dir_->string();
+    source.name = name;
+    source.directory = dir.string();
     source.fps = fps;
-    source.loop = false;
+    source.loop = loop;
     options.sources.push_back(source);
     absl::StatusOr<std::unique_ptr<RunningServer>> server = StartServer(options);
     EXPECT_TRUE(server.ok()) << server.status();
-    if (!server.ok()) return {};
+    if (!server.ok()) return false;
+    server_ = *std::move(server);
     grpc::ChannelArguments args;
     args.SetMaxReceiveMessageSize(-1);
-    auto stub = v1::PerceptionService::NewStub(
-        grpc::CreateCustomChannel("127.0.0.1:" + std::to_string((*server)->port()),
-                                  grpc::InsecureChannelCredentials(), args));
+    stub_ = v1::PerceptionService::NewStub(grpc::CreateCustomChannel(
+        "127.0.0.1:" + std::to_string(server_->port()), grpc::InsecureChannelCredentials(), args));
+    return true;
+  }
+
+  // Streams the recording once at `fps` and returns every response by
+  // frame id.
+  std::map<uint64_t, v1::DetectResponse> StreamAll(bool carry, uint64_t* carried,
+                                                   bool every_frame = false, double fps = 10) {
+    if (!Start("rec", *dir_, fps, /*loop=*/false, carry)) return {};
     v1::StreamDetectionsRequest request;
     request.set_source("rec");
     request.set_box_model("carton_s");
@@ -118,15 +125,18 @@ class StreamCarryTest : public ::testing::Test {
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
     std::unique_ptr<grpc::ClientReader<v1::DetectResponse>> reader =
-        stub->StreamDetections(&context, request);
+        stub_->StreamDetections(&context, request);
     std::map<uint64_t, v1::DetectResponse> responses;
     v1::DetectResponse r;
     while (reader->Read(&r)) responses[r.frame_id()] = r;
     const grpc::Status end = reader->Finish();
     EXPECT_TRUE(end.ok()) << end.error_message();  // the recording played once
-    *carried = (*server)->service().stream_frames_carried();
+    *carried = server_->service().stream_frames_carried();
     return responses;
   }
+
+  std::unique_ptr<RunningServer> server_;
+  std::unique_ptr<v1::PerceptionService::Stub> stub_;
 
   static fs::path* dir_;
   static fs::path* still_;  // the pallet alone, five frames
@@ -141,18 +151,7 @@ fs::path* StreamCarryTest::still_ = nullptr;
 TEST_F(StreamCarryTest, DetectOnASourceCarriesTheLastDetectionOfTheSameScene) {
   for (const bool carry : {true, false}) {
     SCOPED_TRACE(::testing::Message() << "carry " << carry);
-    ServerOptions options;
-    options.listen_address = "127.0.0.1:0";
-    options.carry_unchanged_frames = carry;
-    SourceSpec source;
-    source.name = "still";
-    source.directory = still_->string();
-    source.fps = 20;
-    options.sources.push_back(source);
-    absl::StatusOr<std::unique_ptr<RunningServer>> server = StartServer(options);
-    ASSERT_TRUE(server.ok()) << server.status();
-    auto stub = v1::PerceptionService::NewStub(grpc::CreateChannel(
-        "127.0.0.1:" + std::to_string((*server)->port()), grpc::InsecureChannelCredentials()));
+    ASSERT_TRUE(Start("still", *still_, 20, /*loop=*/true, carry));
     std::vector<v1::DetectResponse> responses;
     uint64_t last_frame = 0;
     for (int call = 0; call < 4; ++call) {
@@ -163,7 +162,7 @@ TEST_F(StreamCarryTest, DetectOnASourceCarriesTheLastDetectionOfTheSameScene) {
       grpc::ClientContext context;
       context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
       v1::DetectResponse r;
-      const grpc::Status s = stub->Detect(&context, request, &r);
+      const grpc::Status s = stub_->Detect(&context, request, &r);
       ASSERT_TRUE(s.ok()) << s.error_message();
       EXPECT_GT(r.frame_id(), last_frame) << "call " << call;
       last_frame = r.frame_id();
@@ -185,7 +184,7 @@ TEST_F(StreamCarryTest, DetectOnASourceCarriesTheLastDetectionOfTheSameScene) {
       }
       EXPECT_EQ(r.edge_points_size() > 0, i % 2 == 1);
     }
-    EXPECT_EQ((*server)->service().detect_calls_carried(), carry ? 3u : 0u);
+    EXPECT_EQ(server_->service().detect_calls_carried(), carry ? 3u : 0u);
   }
 }
 

@@ -138,8 +138,8 @@ RenderedScene Render(const Scene& scene, const SensorOptions& sensor) {
   std::mt19937 rng(scene.noise_seed);
   std::vector<uint32_t> infrared;
   if (sensor.kind == SensorKind::kStereo) {
-    depth = internal::ApplyStereoNoise(caster, texture, cam, sensor.stereo, nominal, rng,
-                                       &out.stats);
+    depth =
+        internal::ApplyStereoNoise(caster, texture, cam, sensor.stereo, nominal, rng, &out.stats);
   } else if (sensor.kind == SensorKind::kTimeOfFlight) {
     depth = internal::ApplyTofNoise(caster, texture, cam, sensor.tof, nominal, rng, &out.stats,
                                     sensor.color.enabled ? &infrared : nullptr);

@@ -328,8 +328,8 @@ int Main(int argc, char** argv) {
   grpc::ClientContext hc;
   hc.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
   grpc::health::v1::HealthCheckResponse answer;
-  const grpc::Status health_after =
-      grpc::health::v1::Health::NewStub(channel)->Check(&hc, grpc::health::v1::HealthCheckRequest(), &answer);
+  const grpc::Status health_after = grpc::health::v1::Health::NewStub(channel)->Check(
+      &hc, grpc::health::v1::HealthCheckRequest(), &answer);
   grpc::ClientContext dc;
   dc.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
   v1::DetectResponse detected;
@@ -339,7 +339,8 @@ int Main(int argc, char** argv) {
   std::printf("soak: %d clients, %.0f s against %s%s\n", clients, wall_s, target.c_str(),
               in_process ? " (in-process server, default ServerOptions)" : "");
   std::printf("calls: %ld, %.1f calls/s\n\n", calls.load(), static_cast<double>(calls) / wall_s);
-  std::printf("| kind | calls | per s | p50 (ms) | p99 (ms) | status codes |\n|---|---|---|---|---|---|\n");
+  std::printf(
+      "| kind | calls | per s | p50 (ms) | p99 (ms) | status codes |\n|---|---|---|---|---|---|\n");
   for (const auto& [kind, tally] : recorder.Take()) {
     std::string codes;
     for (const auto& [code, n] : tally.codes) {
@@ -352,8 +353,8 @@ int Main(int argc, char** argv) {
   std::printf("\nserver resident memory (%s): start %.1f MiB, end %.1f MiB\n",
               server_pid == "self" ? "whole process" : ("pid " + server_pid).c_str(), rss_start,
               rss_end);
-  const bool serving = health_after.ok() &&
-                       answer.status() == grpc::health::v1::HealthCheckResponse::SERVING;
+  const bool serving =
+      health_after.ok() && answer.status() == grpc::health::v1::HealthCheckResponse::SERVING;
   std::printf("after: health %s, Detect %s (%d boxes)\n", serving ? "SERVING" : "NOT SERVING",
               detect_after.ok() ? "OK" : detect_after.error_message().c_str(),
               detected.boxes_size());
