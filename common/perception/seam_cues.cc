@@ -17,24 +17,27 @@ float GreyAt(const DepthImage& image, double u, double v) {
     return std::numeric_limits<float>::quiet_NaN();
   }
   const double fu = u - u0, fv = v - v0;
-  return static_cast<float>((1 - fu) * (1 - fv) * image.grey_at(u0, v0) +
-                            fu * (1 - fv) * image.grey_at(u0 + 1, v0) +
-                            (1 - fu) * fv * image.grey_at(u0, v0 + 1) +
-                            fu * fv * image.grey_at(u0 + 1, v0 + 1));
+  return static_cast<float>(
+      (1 - fu) * (1 - fv) * image.grey_at(u0, v0) + fu * (1 - fv) * image.grey_at(u0 + 1, v0) +
+      (1 - fu) * fv * image.grey_at(u0, v0 + 1) + fu * fv * image.grey_at(u0 + 1, v0 + 1));
 }
 
 }  // namespace
 
 absl::Status SeamCueOptions::Validate() const {
   if (!(min_contrast > 0.0 && min_contrast <= 255.0) ||
+      !(min_line_contrast >= 0.0 && min_line_contrast <= 255.0) ||
+      !(texture_px >= 0.0 && texture_px <= 20.0) ||
+      !(texture_ratio >= 0.0 && texture_ratio <= 10.0) ||
       !(min_coverage > 0.0 && min_coverage <= 1.0) || !(search_px >= 0.0 && search_px <= 20.0) ||
       !(flank_px >= 1.0 && flank_px <= 10.0) || !(end_margin >= 0.0 && end_margin < 0.5) ||
       !(straightness_px > 0.0 && straightness_px <= 10.0)) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "seam cue options out of range: min_contrast=", min_contrast, " (0, 255], min_coverage=",
-        min_coverage, " (0, 1], search_px=", search_px, " [0, 20], flank_px=", flank_px,
-        " [1, 10], end_margin=", end_margin, " [0, 0.5), straightness_px=", straightness_px,
-        " (0, 10]"));
+        "seam cue options out of range: min_contrast=", min_contrast,
+        " (0, 255], min_line_contrast=", min_line_contrast, " [0, 255], texture_px=", texture_px,
+        " [0, 20], texture_ratio=", texture_ratio, " [0, 10], min_coverage=", min_coverage,
+        " (0, 1], search_px=", search_px, " [0, 20], flank_px=", flank_px, " [1, 10], end_margin=",
+        end_margin, " [0, 0.5), straightness_px=", straightness_px, " (0, 10]"));
   }
   return absl::OkStatus();
 }
@@ -46,8 +49,16 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
   const CameraIntrinsics& k = image.camera;
   const double length_px = (Project(k, a) - Project(k, b)).norm();
   const int n = std::clamp(static_cast<int>(length_px / 2.0), 8, 80);
-  std::vector<double> offsets;  // per sample showing a line: its offset, pixels
-  offsets.reserve(n);
+  // Offsets across the side, half a pixel apart: the line is sought within
+  // search_px, parallel lines of a texture beyond it out to texture_px more.
+  const int search_steps = static_cast<int>(std::floor(o.search_px / 0.5 + 1e-9));
+  const int steps = search_steps + static_cast<int>(std::floor(o.texture_px / 0.5 + 1e-9));
+  const int m = 2 * steps + 1;
+  // Per sample and offset: how much darker the line is than the darker of
+  // its two flanks (or the step between them, with accept_steps); NaN
+  // outside the image.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<float> valley(static_cast<size_t>(n) * m, nan);
   double metres_per_px = 0.0;
   for (int i = 0; i < n; ++i) {
     const double t = o.end_margin + (1.0 - 2.0 * o.end_margin) * (i + 0.5) / n;
@@ -58,36 +69,91 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
     if (!(d_px > 1e-6)) continue;
     metres_per_px = 0.01 / d_px;
     d /= d_px;
-    double best = 0.0, best_s = 0.0;
-    for (double s = -o.search_px; s <= o.search_px + 1e-9; s += 0.5) {
-      const Eigen::Vector2d q = c + s * d;
+    for (int j = 0; j < m; ++j) {
+      const Eigen::Vector2d q = c + (j - steps) * 0.5 * d;
       const Eigen::Vector2d l = q - o.flank_px * d, r = q + o.flank_px * d;
       const float gc = GreyAt(image, q.x(), q.y());
       const float gl = GreyAt(image, l.x(), l.y());
       const float gr = GreyAt(image, r.x(), r.y());
       if (std::isnan(gc) || std::isnan(gl) || std::isnan(gr)) continue;
-      // A change of shade between the two sides, or a line darker than both
-      // (preferred where both show, so the offset is the line's middle).
-      const double valley = std::min(gl, gr) - gc;
-      const double strength =
-          o.accept_steps ? std::max<double>(0.75 * std::abs(gl - gr), valley) : valley;
-      if (strength > best) {
-        best = strength;
-        best_s = s;
+      const float dark = std::min(gl, gr) - gc;
+      valley[static_cast<size_t>(i) * m + j] =
+          o.accept_steps ? std::max(0.75f * std::abs(gl - gr), dark) : dark;
+    }
+  }
+  auto at = [&](int i, int j) { return valley[static_cast<size_t>(i) * m + j]; };
+  auto in_search = [&](int j) { return std::abs(j - steps) <= search_steps; };
+
+  // A plain line: each sample's darkest offset, where it is 0.75
+  // min_contrast darker than its flanks; the samples that agree with their
+  // median offset within straightness_px are its coverage.
+  std::vector<double> offsets;  // per sample showing a line: its offset, pixels
+  offsets.reserve(n);
+  for (int i = 0; i < n; ++i) {
+    double best = 0.0, best_s = 0.0;
+    for (int j = steps - search_steps; j <= steps + search_steps; ++j) {
+      const float v = at(i, j);
+      if (!std::isnan(v) && v > best) {
+        best = v;
+        best_s = (j - steps) * 0.5;
       }
     }
     if (best >= 0.75 * o.min_contrast) offsets.push_back(best_s);
   }
-  if (offsets.empty()) return cue;
-  std::vector<double> sorted = offsets;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double median = sorted[sorted.size() / 2];
-  const auto straight = std::count_if(offsets.begin(), offsets.end(), [&](double s) {
-    return std::abs(s - median) <= o.straightness_px;
-  });
-  cue.coverage = static_cast<double>(straight) / n;
-  cue.offset_m = median * metres_per_px;
-  cue.seam = cue.coverage >= o.min_coverage;
+  if (!offsets.empty()) {
+    std::vector<double> sorted = offsets;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    const auto straight = std::count_if(offsets.begin(), offsets.end(), [&](double s) {
+      return std::abs(s - median) <= o.straightness_px;
+    });
+    cue.coverage = static_cast<double>(straight) / n;
+    cue.offset_m = median * metres_per_px;
+    cue.seam = cue.coverage >= o.min_coverage;
+  }
+  if (cue.seam || o.min_line_contrast <= 0.0) return cue;
+
+  // A faint line: the offset whose mean over the whole side is darkest (a
+  // matched filter: the grain of cardboard or brick averages out, a faint
+  // seam adds up). Samples out of view count as no line.
+  std::vector<double> mean(m, -std::numeric_limits<double>::infinity());
+  int line = -1;
+  for (int j = 0; j < m; ++j) {
+    double sum = 0.0;
+    int count = 0;
+    for (int i = 0; i < n; ++i) {
+      if (std::isnan(at(i, j))) continue;
+      sum += at(i, j);
+      ++count;
+    }
+    if (count == 0) continue;
+    mean[j] = sum / n;
+    if (in_search(j) && (line < 0 || mean[j] > mean[line])) line = j;
+  }
+  if (line < 0 || mean[line] < o.min_line_contrast) return cue;
+  // One by one, the samples must show it too (a few dark blotches make no
+  // line), within straightness_px, at half the contrast.
+  const int wander = static_cast<int>(std::floor(o.straightness_px / 0.5 + 1e-9));
+  int showing = 0;
+  for (int i = 0; i < n; ++i) {
+    for (int j = std::max(0, line - wander); j <= std::min(m - 1, line + wander); ++j) {
+      if (at(i, j) >= 0.5 * o.min_line_contrast) {
+        ++showing;
+        break;
+      }
+    }
+  }
+  // And it must stand out from the lines parallel to it clear of its
+  // flanks: wood grain and print are many lines, a seam is one.
+  double texture = 0.0;
+  for (int j = 0; j < m; ++j) {
+    if (std::abs(j - line) * 0.5 >= o.flank_px + 1.5) texture = std::max(texture, mean[j]);
+  }
+  if (showing >= o.min_coverage * n && mean[line] >= o.texture_ratio * texture) {
+    cue.coverage = static_cast<double>(showing) / n;
+    cue.offset_m = (line - steps) * 0.5 * metres_per_px;
+    cue.seam = true;
+  }
   return cue;
 }
 

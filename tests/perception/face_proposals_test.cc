@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "common/perception/planar_patches.h"
@@ -49,12 +50,21 @@ struct LayerFrame {
       }
     }
   }
-  // Grey image: cardboard (150) with dark seam lines (60) at the given
-  // layer coordinates, each line `px` pixels wide, and optional rectangles.
+  // Grey image: cardboard (150) with dark seam lines (seam_grey) at the
+  // given layer coordinates, 4 mm wide, and optional rectangles; with
+  // grain, per-pixel noise of that sigma (grey levels); with stripes,
+  // lines stripe_dark darker every stripe_period_m along a, one at a = 0
+  // (wood grain).
+  float seam_grey = 60.0f;
+  double grain = 0.0;
+  double stripe_period_m = 0.0;
+  float stripe_dark = 0.0f;
   void Paint(const std::vector<double>& seams_a, const std::vector<double>& seams_b,
              const std::vector<Eigen::Vector4d>& dark_rects = {}) {
     const CameraIntrinsics& k = image.camera;
     image.grey.assign(static_cast<size_t>(k.width) * k.height, 150.0f);
+    std::mt19937 rng(11);
+    std::normal_distribution<float> noise(0.0f, static_cast<float>(grain));
     const double half_line = 0.002;  // 4 mm wide lines: ~2 px at 1.2 m
     for (int v = 0; v < k.height; ++v) {
       for (int u = 0; u < k.width; ++u) {
@@ -65,12 +75,17 @@ struct LayerFrame {
           g = 90.0f;  // the floor
           continue;
         }
+        if (stripe_period_m > 0.0) {
+          const double phase = std::remainder(q.x(), stripe_period_m);
+          if (std::abs(phase) < half_line / 2) g -= stripe_dark;
+        }
         for (double a : seams_a) {
-          if (std::abs(q.x() - a) < half_line) g = 60.0f;
+          if (std::abs(q.x() - a) < half_line) g = seam_grey;
         }
         for (double b : seams_b) {
-          if (std::abs(q.y() - b) < half_line) g = 60.0f;
+          if (std::abs(q.y() - b) < half_line) g = seam_grey;
         }
+        if (grain > 0.0) g += noise(rng);
         for (const Eigen::Vector4d& r : dark_rects) {  // a0, b0, a1, b1
           if (q.x() >= r[0] && q.x() <= r[2] && q.y() >= r[1] && q.y() <= r[3]) g = 40.0f;
         }
@@ -351,6 +366,54 @@ TEST(ColourSeamTest, ALabelAcrossTheLineDoesNotMakeASeam) {
   EXPECT_FALSE(CueAtMiddle(f).seam);
 }
 
+// A seam only a few grey levels darker than grainy cardboard (a stereo
+// camera's colour of bricks or cartons at 2 m): no sample shows it plainly,
+// the side's mean does.
+TEST(ColourSeamTest, AFaintSeamOnGrainyCardboardIsASeam) {
+  LayerFrame f;
+  f.width = 0.6;
+  f.height = 0.2;
+  f.Render();
+  f.grain = 5.0;
+  f.seam_grey = 150.0f - 7.0f;
+  f.Paint({0.0}, {});
+  const SeamCue cue = CueAtMiddle(f);
+  EXPECT_TRUE(cue.seam) << "coverage " << cue.coverage;
+  EXPECT_NEAR(cue.offset_m, 0.0, 0.004);
+  // Plain lines only: missed.
+  SeamCueOptions plain;
+  plain.min_line_contrast = 0.0;
+  EXPECT_FALSE(ColourSeamAlong(f.image, f.FromLayer(0.0, -f.height / 2, kTop),
+                               f.FromLayer(0.0, f.height / 2, kTop),
+                               f.FromLayer(1.0, 0.0, 0.0) - f.FromLayer(0.0, 0.0, 0.0), plain)
+                   .seam);
+  // The grain alone makes none.
+  f.Paint({}, {});
+  EXPECT_FALSE(CueAtMiddle(f).seam) << "coverage " << CueAtMiddle(f).coverage;
+}
+
+// Wood grain (a pallet's deck boards): faint lines every few pixels, one of
+// them on the side. A faint line that does not stand out from the lines
+// parallel to it is texture, not a seam.
+TEST(ColourSeamTest, WoodGrainStripesAreNoSeam) {
+  LayerFrame f;
+  f.width = 0.6;
+  f.height = 0.2;
+  f.Render();
+  f.grain = 3.0;
+  f.stripe_period_m = 0.011;  // ~5 px at 1.2 m
+  f.stripe_dark = 9.0f;
+  f.Paint({}, {});
+  EXPECT_FALSE(CueAtMiddle(f).seam) << "coverage " << CueAtMiddle(f).coverage;
+  SeamCueOptions no_texture_check;
+  no_texture_check.texture_ratio = 0.0;
+  EXPECT_TRUE(ColourSeamAlong(f.image, f.FromLayer(0.0, -f.height / 2, kTop),
+                              f.FromLayer(0.0, f.height / 2, kTop),
+                              f.FromLayer(1.0, 0.0, 0.0) - f.FromLayer(0.0, 0.0, 0.0),
+                              no_texture_check)
+                  .seam);
+}
+
 // The layer a face lies on and its tiles: a tile is one, a box turned
 // across the layer (a strip cut off by a false seam, as a Kinect frame of a
 // touching column showed in the simulated cell) or shifted by half a box is
@@ -400,6 +463,9 @@ TEST(FaceProposalOptionsTest, ValidateNamesTheField) {
   o = {};
   o.seams.min_coverage = 2;
   EXPECT_NE(o.Validate().message().find("min_coverage=2"), std::string::npos);
+  o = {};
+  o.seams.texture_ratio = -1;
+  EXPECT_NE(o.Validate().message().find("texture_ratio=-1"), std::string::npos);
   o = {};
   o.patches.step_px = 0;
   EXPECT_NE(o.Validate().message().find("step_px=0"), std::string::npos);
