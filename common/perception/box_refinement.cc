@@ -767,6 +767,15 @@ void ColourSeamSide(const DepthImage& depth, const FaceFrame& f, bool along_a, d
   if (!cue.seam || std::abs(cue.offset_m) > o.seam_search_m + 0.004) return;
   m->kind = SideKind::kSeam;
   m->position = half + cue.offset_m;
+  // Along a long side, the line's turn turns the face as a depth seam's
+  // does (seam_turn_min_length_m): a brick inside a pallet, bounded by
+  // seams the depth does not show, otherwise keeps the turn it came with.
+  const double half_other = along_a ? f.half_b : f.half_a;
+  if (cue.slope && o.seam_turn_min_length_m > 0.0 &&
+      2.0 * (half_other - o.side_band_m) >= o.seam_turn_min_length_m) {
+    const double cap = std::tan(o.seam_turn_max_deg * std::numbers::pi / 180.0);
+    m->seam_slope = std::clamp(*cue.slope, -cap, cap);
+  }
 }
 
 // True when, past a side, the first surface after a run of missing returns

@@ -138,25 +138,19 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
   // Turns box i onto the plane of `normal`, about its face centre, when
   // its face is within max_angle_deg of it, or within adopt_angle_deg and
   // its pixels fit the plane.
+  // Each box's plane is chosen first and applied at the end: a small
+  // group's plane may still give way to a bigger neighbour's.
   std::vector<char> taken(n, 0);
-  int turned = 0;
+  std::vector<Eigen::Vector3d> chosen(n, Eigen::Vector3d::Zero());
   auto take_plane = [&](int i, const Eigen::Vector3d& normal) {
-    DetectedBox& box = (*boxes)[i];
     const Eigen::Vector3d to = normal.dot(faces[i].n) < 0.0 ? -normal : normal;
     const double cos_turn = to.dot(faces[i].n);
     if (cos_turn < cos_adopt || (cos_turn < cos_max && !FitsPlane(depth, faces[i], to, options))) {
-      return;
+      return false;
     }
-    // The smallest rotation taking the face's normal onto the plane's,
-    // about the face centre.
-    const Eigen::Matrix3d turn =
-        Eigen::Quaterniond::FromTwoVectors(faces[i].n, to).toRotationMatrix();
-    const int axis = static_cast<int>(box.grasp_face) / 2;
-    box.camera_T_box.linear() = turn * box.camera_T_box.linear();
-    box.camera_T_box.translation() = box.grasp_centre_camera - to * dims[axis] / 2.0;
-    box.grasp_normal_camera = to;
+    chosen[i] = to;
     taken[i] = 1;
-    ++turned;
+    return true;
   };
   struct Layer {
     Eigen::Vector3d normal, centroid;
@@ -195,6 +189,37 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
     for (int i : members) take_plane(i, normal);
     layers.push_back({normal, sum / count, std::move(members)});
   }
+  // A group beside a bigger one takes its plane
+  // (LayerPlaneOptions::merge_groups); the biggest first.
+  std::sort(layers.begin(), layers.end(),
+            [](const Layer& a, const Layer& b) { return a.members.size() > b.members.size(); });
+  for (size_t small = 1; options.merge_groups && small < layers.size(); ++small) {
+    Layer& s_layer = layers[small];
+    for (size_t big = 0; big < small; ++big) {
+      const Layer& b_layer = layers[big];
+      if (b_layer.members.size() <= s_layer.members.size() ||
+          std::abs(b_layer.normal.dot(s_layer.normal)) < cos_adopt ||
+          std::abs((s_layer.centroid - b_layer.centroid).dot(b_layer.normal)) >
+              options.plane_tolerance_m) {
+        continue;
+      }
+      const bool touches = std::any_of(s_layer.members.begin(), s_layer.members.end(), [&](int j) {
+        return std::any_of(b_layer.members.begin(), b_layer.members.end(),
+                           [&](int i) { return Touch(faces[i], faces[j], options); });
+      });
+      const bool fits = std::all_of(s_layer.members.begin(), s_layer.members.end(), [&](int j) {
+        const Eigen::Vector3d to =
+            b_layer.normal.dot(faces[j].n) < 0.0 ? -b_layer.normal : b_layer.normal;
+        return to.dot(faces[j].n) >= cos_adopt && FitsPlane(depth, faces[j], to, options);
+      });
+      if (!touches || !fits) continue;
+      for (int j : s_layer.members) {
+        chosen[j] = b_layer.normal.dot(faces[j].n) < 0.0 ? -b_layer.normal : b_layer.normal;
+      }
+      s_layer.normal = b_layer.normal;
+      break;
+    }
+  }
   // Faces tilted past max_angle_deg that touch a layer's member with
   // their centre on its plane (they joined no group: their tilt is their
   // noise's) take it when their pixels fit it.
@@ -211,10 +236,23 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
             std::abs((faces[j].c - layer.centroid).dot(layer.normal)) > options.plane_tolerance_m) {
           continue;
         }
-        take_plane(j, layer.normal);
-        if (taken[j]) break;
+        if (take_plane(j, layer.normal)) break;
       }
     }
+  }
+  // The smallest rotation taking each face's normal onto its plane's,
+  // about the face centre.
+  int turned = 0;
+  for (int i = 0; i < n; ++i) {
+    if (!taken[i]) continue;
+    DetectedBox& box = (*boxes)[i];
+    const Eigen::Matrix3d turn =
+        Eigen::Quaterniond::FromTwoVectors(faces[i].n, chosen[i]).toRotationMatrix();
+    const int axis = static_cast<int>(box.grasp_face) / 2;
+    box.camera_T_box.linear() = turn * box.camera_T_box.linear();
+    box.camera_T_box.translation() = box.grasp_centre_camera - chosen[i] * dims[axis] / 2.0;
+    box.grasp_normal_camera = chosen[i];
+    ++turned;
   }
   return turned;
 }

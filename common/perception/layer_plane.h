@@ -49,6 +49,14 @@ struct LayerPlaneOptions {
   // tilted that far does not fit the layer's plane. Degrees, [0, 45];
   // at most max_angle_deg turns this off.
   double adopt_angle_deg = 25.0;
+  // A group beside a bigger one, its faces' centres on the bigger one's
+  // plane, takes that plane when its normal is within adopt_angle_deg of
+  // it and every one of its faces fits it as above: three bricks under one
+  // blob of an active-stereo camera's noise at 2 m tilt together by 11
+  // degrees, form a group of their own and fit a plane as wrong as theirs,
+  // beside a layer of thirty whose plane is right. False: every group keeps
+  // its own plane.
+  bool merge_groups = true;
 
   absl::Status Validate() const;
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -82,6 +83,31 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
     }
   }
   auto at = [&](int i, int j) { return valley[static_cast<size_t>(i) * m + j]; };
+  const int wander = static_cast<int>(std::floor(o.straightness_px / 0.5 + 1e-9));
+  // The line's turn against the side: where each half of the side has it
+  // darkest (within straightness_px of `line`), over the distance between
+  // the halves' middles.
+  auto slope_at = [&](int line) -> std::optional<double> {
+    double where[2];
+    for (int h = 0; h < 2; ++h) {
+      const int i0 = h * n / 2, i1 = (h + 1) * n / 2;
+      double darkest = -std::numeric_limits<double>::infinity();
+      where[h] = line;
+      for (int j = std::max(0, line - wander); j <= std::min(m - 1, line + wander); ++j) {
+        double sum = 0.0;
+        for (int i = i0; i < i1; ++i) {
+          if (!std::isnan(at(i, j))) sum += at(i, j);
+        }
+        if (sum > darkest) {
+          darkest = sum;
+          where[h] = j;
+        }
+      }
+    }
+    const double apart_m = 0.5 * (1.0 - 2.0 * o.end_margin) * (b - a).norm();
+    if (!(apart_m > 0.0)) return std::nullopt;
+    return (where[1] - where[0]) * 0.5 * metres_per_px / apart_m;
+  };
   auto in_search = [&](int j) { return std::abs(j - steps) <= search_steps; };
 
   // A plain line: each sample's darkest offset, where it is 0.75
@@ -110,6 +136,7 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
     cue.coverage = static_cast<double>(straight) / n;
     cue.offset_m = median * metres_per_px;
     cue.seam = cue.coverage >= o.min_coverage;
+    if (cue.seam) cue.slope = slope_at(steps + static_cast<int>(std::lround(median / 0.5)));
   }
   if (cue.seam || o.min_line_contrast <= 0.0) return cue;
 
@@ -133,7 +160,6 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
   if (line < 0 || mean[line] < o.min_line_contrast) return cue;
   // One by one, the samples must show it too (a few dark blotches make no
   // line), within straightness_px, at half the contrast.
-  const int wander = static_cast<int>(std::floor(o.straightness_px / 0.5 + 1e-9));
   int showing = 0;
   for (int i = 0; i < n; ++i) {
     for (int j = std::max(0, line - wander); j <= std::min(m - 1, line + wander); ++j) {
@@ -153,6 +179,7 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
     cue.coverage = static_cast<double>(showing) / n;
     cue.offset_m = (line - steps) * 0.5 * metres_per_px;
     cue.seam = true;
+    cue.slope = slope_at(line);
   }
   return cue;
 }

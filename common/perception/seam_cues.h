@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 
 #include "absl/status/status.h"
 #include "common/perception/camera_model.h"
@@ -62,6 +63,10 @@ struct SeamCue {
   double coverage = 0.0;  // share of samples showing the line at its offset
   double offset_m = 0.0;  // where the line lies, along `across` from the side
   bool seam = false;      // a plain line, or a faint one (SeamCueOptions)
+  // A seam's turn against the side: its offset's change per metre along
+  // the side from a to b, from where each half of the side has it (half a
+  // pixel steps).
+  std::optional<double> slope;
 };
 
 // Looks for a seam along the side from a to b (camera frame, metres) on a

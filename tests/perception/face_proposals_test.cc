@@ -56,6 +56,7 @@ struct LayerFrame {
   // lines stripe_dark darker every stripe_period_m along a, one at a = 0
   // (wood grain).
   float seam_grey = 60.0f;
+  double seam_slope = 0.0;  // seams along a run at a + seam_slope b
   double grain = 0.0;
   double stripe_period_m = 0.0;
   float stripe_dark = 0.0f;
@@ -80,7 +81,7 @@ struct LayerFrame {
           if (std::abs(phase) < half_line / 2) g -= stripe_dark;
         }
         for (double a : seams_a) {
-          if (std::abs(q.x() - a) < half_line) g = seam_grey;
+          if (std::abs(q.x() - a - seam_slope * q.y()) < half_line) g = seam_grey;
         }
         for (double b : seams_b) {
           if (std::abs(q.y() - b) < half_line) g = seam_grey;
@@ -390,6 +391,31 @@ TEST(ColourSeamTest, AFaintSeamOnGrainyCardboardIsASeam) {
   // The grain alone makes none.
   f.Paint({}, {});
   EXPECT_FALSE(CueAtMiddle(f).seam) << "coverage " << CueAtMiddle(f).coverage;
+}
+
+// A seam's turn against the side: where each half of the side has it.
+TEST(ColourSeamTest, ASlantedSeamGivesItsSlope) {
+  LayerFrame f;
+  f.width = 0.6;
+  f.height = 0.4;
+  f.Render();
+  for (double slope : {0.0, 0.02, -0.02}) {
+    f.seam_slope = slope;
+    f.Paint({0.0}, {});
+    const SeamCue cue = CueAtMiddle(f);
+    ASSERT_TRUE(cue.seam) << slope;
+    ASSERT_TRUE(cue.slope.has_value()) << slope;
+    EXPECT_NEAR(*cue.slope, slope, 0.01) << slope;
+  }
+  // A faint one too.
+  f.grain = 4.0;
+  f.seam_grey = 150.0f - 8.0f;
+  f.seam_slope = 0.01;
+  f.Paint({0.0}, {});
+  const SeamCue faint = CueAtMiddle(f);
+  ASSERT_TRUE(faint.seam) << "coverage " << faint.coverage;
+  ASSERT_TRUE(faint.slope.has_value());
+  EXPECT_NEAR(*faint.slope, 0.01, 0.01);
 }
 
 // Wood grain (a pallet's deck boards): faint lines every few pixels, one of
