@@ -60,30 +60,45 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
   // outside the image.
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::vector<float> valley(static_cast<size_t>(n) * m, nan);
+  // Per sample: where it lies and the unit direction across, in pixels.
+  std::vector<Eigen::Vector2d> centre(n), unit(n);
+  std::vector<char> usable(n, 0);
   double metres_per_px = 0.0;
   for (int i = 0; i < n; ++i) {
     const double t = o.end_margin + (1.0 - 2.0 * o.end_margin) * (i + 0.5) / n;
     const Eigen::Vector3d p = a + t * (b - a);
-    const Eigen::Vector2d c = Project(k, p);
-    Eigen::Vector2d d = Project(k, p + 0.01 * across) - c;  // 1 cm across, in pixels
+    centre[i] = Project(k, p);
+    Eigen::Vector2d d = Project(k, p + 0.01 * across) - centre[i];  // 1 cm across, in pixels
     const double d_px = d.norm();
     if (!(d_px > 1e-6)) continue;
     metres_per_px = 0.01 / d_px;
-    d /= d_px;
-    for (int j = 0; j < m; ++j) {
-      const Eigen::Vector2d q = c + (j - steps) * 0.5 * d;
-      const Eigen::Vector2d l = q - o.flank_px * d, r = q + o.flank_px * d;
-      const float gc = GreyAt(image, q.x(), q.y());
-      const float gl = GreyAt(image, l.x(), l.y());
-      const float gr = GreyAt(image, r.x(), r.y());
-      if (std::isnan(gc) || std::isnan(gl) || std::isnan(gr)) continue;
-      const float dark = std::min(gl, gr) - gc;
-      valley[static_cast<size_t>(i) * m + j] =
-          o.accept_steps ? std::max(0.75f * std::abs(gl - gr), dark) : dark;
-    }
+    unit[i] = d / d_px;
+    usable[i] = 1;
   }
+  // The valleys at offsets j0..j1 (the texture band is read only when a
+  // faint line asks for it).
+  auto fill = [&](int j0, int j1) {
+    for (int i = 0; i < n; ++i) {
+      if (!usable[i]) continue;
+      const Eigen::Vector2d& d = unit[i];
+      for (int j = std::max(0, j0); j <= std::min(m - 1, j1); ++j) {
+        const Eigen::Vector2d q = centre[i] + (j - steps) * 0.5 * d;
+        const Eigen::Vector2d l = q - o.flank_px * d, r = q + o.flank_px * d;
+        const float gc = GreyAt(image, q.x(), q.y());
+        const float gl = GreyAt(image, l.x(), l.y());
+        const float gr = GreyAt(image, r.x(), r.y());
+        if (std::isnan(gc) || std::isnan(gl) || std::isnan(gr)) continue;
+        const float dark = std::min(gl, gr) - gc;
+        valley[static_cast<size_t>(i) * m + j] =
+            o.accept_steps ? std::max(0.75f * std::abs(gl - gr), dark) : dark;
+      }
+    }
+  };
+  const int wander_steps = static_cast<int>(std::floor(o.straightness_px / 0.5 + 1e-9));
+  const int inner = search_steps + wander_steps;  // the line and its wander
+  fill(steps - inner, steps + inner);
   auto at = [&](int i, int j) { return valley[static_cast<size_t>(i) * m + j]; };
-  const int wander = static_cast<int>(std::floor(o.straightness_px / 0.5 + 1e-9));
+  const int wander = wander_steps;
   // The line's turn against the side: where each half of the side has it
   // darkest (within straightness_px of `line`), over the distance between
   // the halves' middles.
@@ -171,9 +186,16 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
   }
   // And it must stand out from the lines parallel to it clear of its
   // flanks: wood grain and print are many lines, a seam is one.
+  fill(0, steps - inner - 1);
+  fill(steps + inner + 1, m - 1);
   double texture = 0.0;
   for (int j = 0; j < m; ++j) {
-    if (std::abs(j - line) * 0.5 >= o.flank_px + 1.5) texture = std::max(texture, mean[j]);
+    if (std::abs(j - line) * 0.5 < o.flank_px + 1.5) continue;
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+      if (!std::isnan(at(i, j))) sum += at(i, j);
+    }
+    texture = std::max(texture, sum / n);
   }
   if (showing >= o.min_coverage * n && mean[line] >= o.texture_ratio * texture) {
     cue.coverage = static_cast<double>(showing) / n;
