@@ -418,6 +418,31 @@ TEST(ColourSeamTest, ASlantedSeamGivesItsSlope) {
   EXPECT_NEAR(*faint.slope, 0.01, 0.01);
 }
 
+// Degenerate sides: wholly outside the image, of zero length, or behind the
+// camera give no seam (and no slope), whatever the options.
+TEST(ColourSeamTest, DegenerateSidesAreNoSeam) {
+  LayerFrame f;
+  f.Render();
+  f.grain = 5.0;
+  f.Paint({0.0}, {});
+  const Eigen::Vector3d across(1.0, 0.0, 0.0);
+  for (const SeamCueOptions& o : {SeamCueOptions{}, [] {
+                                    SeamCueOptions t;
+                                    t.texture_px = 0.0;
+                                    t.search_px = 0.0;
+                                    return t;
+                                  }()}) {
+    const SeamCue outside = ColourSeamAlong(f.image, Eigen::Vector3d(5.0, 5.0, 1.2),
+                                            Eigen::Vector3d(5.0, 5.3, 1.2), across, o);
+    EXPECT_FALSE(outside.seam);
+    EXPECT_FALSE(outside.slope.has_value());
+    const Eigen::Vector3d p = f.FromLayer(0.0, 0.0, kTop);
+    const SeamCue point = ColourSeamAlong(f.image, p, p, across, o);
+    EXPECT_FALSE(point.slope.has_value());
+    EXPECT_FALSE(ColourSeamAlong(f.image, -p, p, across, o).seam);
+  }
+}
+
 // Wood grain (a pallet's deck boards): faint lines every few pixels, one of
 // them on the side. A faint line that does not stand out from the lines
 // parallel to it is texture, not a seam.
