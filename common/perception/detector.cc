@@ -1,11 +1,13 @@
 #include "common/perception/detector.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -81,34 +83,73 @@ bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<std::array<SideKind, 4
 }
 
 // A box cannot reach through the floor. The floor is the farthest large
-// plane the camera sees (a planar patch of at least floor_min_area_m2, and
-// three of the box's largest faces, whose plane lies farthest from the
-// camera along its normal: the floor or table under a pallet, a heap or a
-// bin), with no more than 1 % of the frame beyond it. A box with a corner more than
-// floor_tolerance_m beyond it is taken out: a "box" whose face is a pallet's deck board reaches its
-// own height into the floor. True when a box was taken out.
+// plane the camera sees (the planar patches on one plane, together at least
+// floor_min_area_m2 and three of the box's largest faces, whose plane lies
+// farthest from the camera along its normal: the floor or table under a
+// pallet, a heap or a bin), with no more than 1 % of the frame beyond it
+// (past floor_tolerance_m, or three times the floor's own scatter scaled by
+// z^2 to the point's depth). A box with a corner more than
+// floor_tolerance_m beyond it is taken out: a "box" whose face is a pallet's
+// deck board reaches its own height into the floor, and so does a box of
+// another size read as this one on end. True when a box was taken out.
 bool CheckFloor(const DepthImage& depth, const DetectorOptions& options, const FaceProposals& faces,
                 std::vector<DetectedBox>* boxes, std::vector<std::array<SideKind, 4>>* sides,
                 std::vector<DeclinedCandidate>* declined) {
   const BoxDims& d = options.box;
   const double largest_face = std::max({d.l * d.b, d.l * d.h, d.b * d.h});
   const double min_area = std::max(options.floor_min_area_m2, 3.0 * largest_face);
-  const PlanarPatch* floor = nullptr;
-  double floor_distance = 0.0;
-  for (const PlanarPatch& patch : faces.patches.patches) {
+  auto area_of = [&](const PlanarPatch& patch) {
     const double cell_m = patch.centroid.z() / depth.camera.fx * faces.patches.step_px;
-    if (patch.points.size() * cell_m * cell_m < min_area) continue;
+    return patch.points.size() * cell_m * cell_m;
+  };
+  // The floor's plane (a point on it and its normal) and how far its own
+  // points scatter about it.
+  struct Floor {
+    Eigen::Vector3d normal, centroid;
+    double rms = 0.0;
+  };
+  std::optional<Floor> floor;
+  double floor_distance = 0.0;
+  const double cos_floor = std::cos(10.0 * M_PI / 180.0);
+  for (const PlanarPatch& patch : faces.patches.patches) {
+    // A noisy floor comes out of the segmentation in pieces (an active
+    // stereo camera at 2.5 m: none of them 0.36 m^2): a patch's plane takes
+    // in every patch on it, and is fitted through all their points.
+    if (area_of(patch) < 0.1 * min_area) continue;
+    double area = 0.0, count = 0.0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+    for (const PlanarPatch& other : faces.patches.patches) {
+      if (&other != &patch && (other.normal.dot(patch.normal) < cos_floor ||
+                               std::abs(patch.normal.dot(other.centroid - patch.centroid)) >
+                                   options.floor_tolerance_m)) {
+        continue;
+      }
+      area += area_of(other);
+      for (const Eigen::Vector3d& q : other.points) {
+        sum += q;
+        outer += q * q.transpose();
+        count += 1.0;
+      }
+    }
+    if (area < min_area) continue;
+    const Eigen::Vector3d centroid = sum / count;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / count -
+                                                       centroid * centroid.transpose());
+    Eigen::Vector3d normal = eig.eigenvectors().col(0);
+    if (normal.dot(centroid) > 0.0) normal = -normal;
     // The normal points at the camera, so the plane is n.x = -distance.
-    const double distance = -patch.normal.dot(patch.centroid);
+    const double distance = -normal.dot(centroid);
     if (distance > floor_distance) {
       floor_distance = distance;
-      floor = &patch;
+      floor = Floor{normal, centroid, std::sqrt(std::max(0.0, eig.eigenvalues()(0)))};
     }
   }
-  if (floor == nullptr) return false;
+  if (!floor) return false;
   // It is the floor only when nothing lies beyond it: a lower layer's top
   // or a pallet deck may be the farthest plane found while the floor itself
-  // (noisy, or cut up) is no patch.
+  // (noisy, or cut up) is no patch. Beyond: past the tolerance, or past
+  // three times the floor's own scatter at the point's depth.
   int seen = 0, beyond = 0;
   for (int v = 0; v < depth.camera.height; v += 4) {
     for (int u = 0; u < depth.camera.width; u += 4) {
@@ -116,7 +157,11 @@ bool CheckFloor(const DepthImage& depth, const DetectorOptions& options, const F
       if (std::isnan(z)) continue;
       ++seen;
       const Eigen::Vector3d p = z * PixelRay(depth.camera, u, v);
-      beyond += -floor->normal.dot(p - floor->centroid) > options.floor_tolerance_m;
+      // Depth noise grows with z^2: the floor's scatter, measured about its
+      // centroid's depth, scaled to this point's.
+      const double zr = p.z() / floor->centroid.z();
+      const double limit = std::max(options.floor_tolerance_m, 3.0 * floor->rms * zr * zr);
+      beyond += -floor->normal.dot(p - floor->centroid) > limit;
     }
   }
   if (seen == 0 || beyond > 0.01 * seen) return false;

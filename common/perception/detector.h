@@ -82,9 +82,9 @@ struct DetectorOptions {
   bool face_proposals = true;
   FaceProposalOptions faces;
   // With face proposals: no box reaches more than floor_tolerance_m through
-  // the floor, the farthest planar patch of at least floor_min_area_m2 (and
-  // three of the box's largest faces) the camera sees (detector.cc,
-  // CheckFloor). Metres, square metres.
+  // the floor, the farthest plane the camera sees with planar patches of at
+  // least floor_min_area_m2 (and three of the box's largest faces) on it
+  // (detector.cc, CheckFloor). Metres, square metres.
   bool floor_check = true;
   // Returned boxes side by side on one plane (a pallet layer) take the
   // plane fitted through all their faces (layer_plane.h; max_angle_deg 0
