@@ -309,6 +309,15 @@ TEST(FaceProposalsTest, ColourSeamsDecideBetweenTwoTilings) {
   ExpectTiles(f, q.poses, 0.20, 0.30);
 }
 
+// A row of cartons, 0.6 x 0.2 m, rendered.
+LayerFrame OneRow() {
+  LayerFrame f;
+  f.width = 0.6;
+  f.height = 0.2;
+  f.Render();
+  return f;
+}
+
 // The line along a = 0 across the whole layer, from b = -h/2 to h/2.
 SeamCue CueAtMiddle(const LayerFrame& f) {
   return ColourSeamAlong(f.image, f.FromLayer(0.0, -f.height / 2, kTop),
@@ -317,10 +326,7 @@ SeamCue CueAtMiddle(const LayerFrame& f) {
 }
 
 TEST(ColourSeamTest, ARealSeamRunningTheWholeSideIsASeam) {
-  LayerFrame f;
-  f.width = 0.6;
-  f.height = 0.2;
-  f.Render();
+  LayerFrame f = OneRow();
   f.Paint({0.0}, {});
   const SeamCue cue = CueAtMiddle(f);
   EXPECT_TRUE(cue.seam);
@@ -332,10 +338,7 @@ TEST(ColourSeamTest, ARealSeamRunningTheWholeSideIsASeam) {
 // steps of shade running the whole face. A step is not a seam (by default);
 // the dark line where two boxes meet is.
 TEST(ColourSeamTest, TheEdgeOfATapeStripIsNotASeam) {
-  LayerFrame f;
-  f.width = 0.6;
-  f.height = 0.2;
-  f.Render();
+  LayerFrame f = OneRow();
   // A darker strip from a = 0 to a = 0.05 over the whole height: its edge
   // lies on the line a = 0.
   f.Paint({}, {}, {Eigen::Vector4d(0.0, -0.1, 0.05, 0.1)});
@@ -349,10 +352,7 @@ TEST(ColourSeamTest, TheEdgeOfATapeStripIsNotASeam) {
 }
 
 TEST(ColourSeamTest, ALabelAcrossTheLineDoesNotMakeASeam) {
-  LayerFrame f;
-  f.width = 0.6;
-  f.height = 0.2;
-  f.Render();
+  LayerFrame f = OneRow();
   // A dark label 8 x 6 cm straddling a = 0 (its edges cross the line), and
   // a barcode-like block whose edge lies on the line over a third of it.
   f.Paint({}, {},
@@ -371,10 +371,7 @@ TEST(ColourSeamTest, ALabelAcrossTheLineDoesNotMakeASeam) {
 // camera's colour of bricks or cartons at 2 m): no sample shows it plainly,
 // the side's mean does.
 TEST(ColourSeamTest, AFaintSeamOnGrainyCardboardIsASeam) {
-  LayerFrame f;
-  f.width = 0.6;
-  f.height = 0.2;
-  f.Render();
+  LayerFrame f = OneRow();
   f.grain = 5.0;
   f.seam_grey = 150.0f - 7.0f;
   f.Paint({0.0}, {});
@@ -447,10 +444,7 @@ TEST(ColourSeamTest, DegenerateSidesAreNoSeam) {
 // them on the side. A faint line that does not stand out from the lines
 // parallel to it is texture, not a seam.
 TEST(ColourSeamTest, WoodGrainStripesAreNoSeam) {
-  LayerFrame f;
-  f.width = 0.6;
-  f.height = 0.2;
-  f.Render();
+  LayerFrame f = OneRow();
   f.grain = 3.0;
   f.stripe_period_m = 0.011;  // ~5 px at 1.2 m
   f.stripe_dark = 9.0f;

@@ -36,6 +36,16 @@ PoseError AgainstNearest(const DetectedBox& box, const std::vector<GroundTruthBo
   return nearest;
 }
 
+// Returned boxes 2 cm or 10 degrees or more from every box of the frame.
+int WrongBoxes(const Detection& det, const RenderedScene& r) {
+  int wrong = 0;
+  for (const DetectedBox& b : det.boxes) {
+    const PoseError nearest = AgainstNearest(b, r.boxes);
+    wrong += nearest.translation_m > 0.02 || nearest.rotation_deg > 10.0;
+  }
+  return wrong;
+}
+
 // Frame `i` of one of scripts/evaluate's generated Kinect sets
 // (make_frames --sensor kinect --kind KIND --seed S renders frame i with
 // seed 1000 S + i), as the generator renders it.
@@ -510,11 +520,7 @@ TEST(RegressionTest, ABoxLevelWithItsNeighboursDoesNotReachFarBelowThem) {
     options.max_below_neighbours_m = below;
     const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
     ASSERT_TRUE(det.ok()) << det.status();
-    int wrong = 0;
-    for (const DetectedBox& b : det->boxes) {
-      const PoseError nearest = AgainstNearest(b, r.boxes);
-      wrong += nearest.translation_m > 0.02 || nearest.rotation_deg > 10.0;
-    }
+    const int wrong = WrongBoxes(*det, r);
     EXPECT_GE(det->boxes.size(), 10u) << "check at " << below;
     if (below > 0.0) {
       EXPECT_EQ(wrong, 0);
@@ -544,11 +550,7 @@ TEST(RegressionTest, ACartonReadOnItsEndInsideAFlatOnesTopIsTakenOut) {
     options.max_below_neighbours_m = below;
     const absl::StatusOr<Detection> det = DetectBoxes(r.cloud, options);
     ASSERT_TRUE(det.ok()) << det.status();
-    int wrong = 0;
-    for (const DetectedBox& b : det->boxes) {
-      const PoseError nearest = AgainstNearest(b, r.boxes);
-      wrong += nearest.translation_m > 0.02 || nearest.rotation_deg > 10.0;
-    }
+    const int wrong = WrongBoxes(*det, r);
     EXPECT_GE(det->boxes.size(), 6u) << "check at " << below;
     if (below > 0.0) {
       EXPECT_EQ(wrong, 0);
@@ -580,11 +582,7 @@ TEST(RegressionTest, ABoxOfAnotherSizeReadOnEndReachesIntoANoisyFloor) {
     options.floor_check = check;
     const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
     ASSERT_TRUE(det.ok()) << det.status();
-    int wrong = 0;
-    for (const DetectedBox& b : det->boxes) {
-      const PoseError nearest = AgainstNearest(b, r.boxes);
-      wrong += nearest.translation_m > 0.02 || nearest.rotation_deg > 10.0;
-    }
+    const int wrong = WrongBoxes(*det, r);
     if (check) {
       EXPECT_EQ(wrong, 0);
       EXPECT_TRUE(
