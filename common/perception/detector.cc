@@ -82,19 +82,19 @@ bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<std::array<SideKind, 4
   return removed;
 }
 
-// A box cannot reach through the floor. The floor is the farthest large
-// plane the camera sees (the planar patches on one plane, together at least
-// floor_min_area_m2 and three of the box's largest faces, whose plane lies
-// farthest from the camera along its normal: the floor or table under a
-// pallet, a heap or a bin), with no more than 1 % of the frame beyond it
-// (past floor_tolerance_m, or three times the floor's own scatter scaled by
-// z^2 to the point's depth). A box with a corner more than
-// floor_tolerance_m beyond it is taken out: a "box" whose face is a pallet's
-// deck board reaches its own height into the floor, and so does a box of
-// another size read as this one on end. True when a box was taken out.
-bool CheckFloor(const DepthImage& depth, const DetectorOptions& options, const FaceProposals& faces,
-                std::vector<DetectedBox>* boxes, std::vector<std::array<SideKind, 4>>* sides,
-                std::vector<DeclinedCandidate>* declined) {
+// The floor: the farthest large plane the camera sees (the planar patches
+// on one plane, together at least floor_min_area_m2 and three of the box's
+// largest faces, whose plane lies farthest from the camera along its
+// normal: the floor or table under a pallet, a heap or a bin), with no more
+// than 1 % of the frame beyond it (past floor_tolerance_m, or three times
+// the floor's own scatter scaled by z^2 to the point's depth). Found once a
+// frame: the patches do not change between the checks' rounds.
+struct FloorPlane {
+  Eigen::Vector3d normal, centroid;  // the normal points at the camera
+  double rms = 0.0;                  // its points' scatter about it, metres
+};
+std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptions& options,
+                                    const FaceProposals& faces) {
   const BoxDims& d = options.box;
   const double largest_face = std::max({d.l * d.b, d.l * d.h, d.b * d.h});
   const double min_area = std::max(options.floor_min_area_m2, 3.0 * largest_face);
@@ -102,13 +102,7 @@ bool CheckFloor(const DepthImage& depth, const DetectorOptions& options, const F
     const double cell_m = patch.centroid.z() / depth.camera.fx * faces.patches.step_px;
     return patch.points.size() * cell_m * cell_m;
   };
-  // The floor's plane (a point on it and its normal) and how far its own
-  // points scatter about it.
-  struct Floor {
-    Eigen::Vector3d normal, centroid;
-    double rms = 0.0;
-  };
-  std::optional<Floor> floor;
+  std::optional<FloorPlane> floor;
   double floor_distance = 0.0;
   const double cos_floor = std::cos(10.0 * M_PI / 180.0);
   for (const PlanarPatch& patch : faces.patches.patches) {
@@ -142,10 +136,10 @@ bool CheckFloor(const DepthImage& depth, const DetectorOptions& options, const F
     const double distance = -normal.dot(centroid);
     if (distance > floor_distance) {
       floor_distance = distance;
-      floor = Floor{normal, centroid, std::sqrt(std::max(0.0, eig.eigenvalues()(0)))};
+      floor = FloorPlane{normal, centroid, std::sqrt(std::max(0.0, eig.eigenvalues()(0)))};
     }
   }
-  if (!floor) return false;
+  if (!floor) return std::nullopt;
   // It is the floor only when nothing lies beyond it: a lower layer's top
   // or a pallet deck may be the farthest plane found while the floor itself
   // (noisy, or cut up) is no patch. Beyond: past the tolerance, or past
@@ -164,7 +158,19 @@ bool CheckFloor(const DepthImage& depth, const DetectorOptions& options, const F
       beyond += -floor->normal.dot(p - floor->centroid) > limit;
     }
   }
-  if (seen == 0 || beyond > 0.01 * seen) return false;
+  if (seen == 0 || beyond > 0.01 * seen) return std::nullopt;
+  return floor;
+}
+
+// A box cannot reach through the floor: one with a corner more than
+// floor_tolerance_m beyond it is taken out (a "box" whose face is a
+// pallet's deck board reaches its own height into the floor, and so does a
+// box of another size read as this one on end). True when a box was taken
+// out.
+bool CheckFloor(const FloorPlane& floor, const DetectorOptions& options,
+                std::vector<DetectedBox>* boxes, std::vector<std::array<SideKind, 4>>* sides,
+                std::vector<DeclinedCandidate>* declined) {
+  const BoxDims& d = options.box;
   return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
     const Eigen::Isometry3d& pose = (*boxes)[i].camera_T_box;
     double deepest = -std::numeric_limits<double>::max();
@@ -173,7 +179,7 @@ bool CheckFloor(const DepthImage& depth, const DetectorOptions& options, const F
           pose * Eigen::Vector3d((c & 1 ? 0.5 : -0.5) * d.l, (c & 2 ? 0.5 : -0.5) * d.b,
                                  (c & 4 ? 0.5 : -0.5) * d.h);
       // How far beyond the floor, away from the camera.
-      deepest = std::max(deepest, -floor->normal.dot(corner - floor->centroid));
+      deepest = std::max(deepest, -floor.normal.dot(corner - floor.centroid));
     }
     if (deepest <= options.floor_tolerance_m) return "";
     return absl::StrFormat(
@@ -673,10 +679,11 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
         MeasureBox(f.depth, d.camera_T_box, options.box, options.evidence).support();
   }
   acceptance->AcceptAll();
+  const std::optional<FloorPlane> floor =
+      options.floor_check ? FindFloor(f.depth, options, faces) : std::nullopt;
   auto check = [&] {
     const bool floor_removed =
-        options.floor_check &&
-        CheckFloor(f.depth, options, faces, &det->boxes, acceptance->sides_of(), declined);
+        floor && CheckFloor(*floor, options, &det->boxes, acceptance->sides_of(), declined);
     const bool layer_removed =
         options.faces.check_layer_tiling &&
         CheckLayers(f.depth, options, faces, &det->boxes, acceptance->sides_of(), declined);

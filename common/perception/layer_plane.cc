@@ -142,8 +142,12 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
   // group's plane may still give way to a bigger neighbour's.
   std::vector<char> taken(n, 0);
   std::vector<Eigen::Vector3d> chosen(n, Eigen::Vector3d::Zero());
+  // A plane's normal, turned to face i's side.
+  auto toward = [&](int i, const Eigen::Vector3d& normal) -> Eigen::Vector3d {
+    return normal.dot(faces[i].n) < 0.0 ? -normal : normal;
+  };
   auto take_plane = [&](int i, const Eigen::Vector3d& normal) {
-    const Eigen::Vector3d to = normal.dot(faces[i].n) < 0.0 ? -normal : normal;
+    const Eigen::Vector3d to = toward(i, normal);
     const double cos_turn = to.dot(faces[i].n);
     if (cos_turn < cos_adopt || (cos_turn < cos_max && !FitsPlane(depth, faces[i], to, options))) {
       return false;
@@ -208,13 +212,12 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
                            [&](int i) { return Touch(faces[i], faces[j], options); });
       });
       const bool fits = std::all_of(s_layer.members.begin(), s_layer.members.end(), [&](int j) {
-        const Eigen::Vector3d to =
-            b_layer.normal.dot(faces[j].n) < 0.0 ? -b_layer.normal : b_layer.normal;
+        const Eigen::Vector3d to = toward(j, b_layer.normal);
         return to.dot(faces[j].n) >= cos_adopt && FitsPlane(depth, faces[j], to, options);
       });
       if (!touches || !fits) continue;
       for (int j : s_layer.members) {
-        chosen[j] = b_layer.normal.dot(faces[j].n) < 0.0 ? -b_layer.normal : b_layer.normal;
+        chosen[j] = toward(j, b_layer.normal);
       }
       s_layer.normal = b_layer.normal;
       break;

@@ -94,11 +94,10 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
       }
     }
   };
-  const int wander_steps = static_cast<int>(std::floor(o.straightness_px / 0.5 + 1e-9));
-  const int inner = search_steps + wander_steps;  // the line and its wander
+  const int wander = static_cast<int>(std::floor(o.straightness_px / 0.5 + 1e-9));
+  const int inner = search_steps + wander;  // the line and its wander
   fill(steps - inner, steps + inner);
   auto at = [&](int i, int j) { return valley[static_cast<size_t>(i) * m + j]; };
-  const int wander = wander_steps;
   // The line's turn against the side: where each half of the side has it
   // darkest (within straightness_px of `line`), over the distance between
   // the halves' middles.
@@ -123,7 +122,6 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
     if (!(apart_m > 0.0)) return std::nullopt;
     return (where[1] - where[0]) * 0.5 * metres_per_px / apart_m;
   };
-  auto in_search = [&](int j) { return std::abs(j - steps) <= search_steps; };
 
   // A plain line: each sample's darkest offset, where it is 0.75
   // min_contrast darker than its flanks; the samples that agree with their
@@ -158,9 +156,9 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
   // A faint line: the offset whose mean over the whole side is darkest (a
   // matched filter: the grain of cardboard or brick averages out, a faint
   // seam adds up). Samples out of view count as no line.
-  std::vector<double> mean(m, -std::numeric_limits<double>::infinity());
   int line = -1;
-  for (int j = 0; j < m; ++j) {
+  double line_mean = 0.0;
+  for (int j = steps - search_steps; j <= steps + search_steps; ++j) {
     double sum = 0.0;
     int count = 0;
     for (int i = 0; i < n; ++i) {
@@ -169,10 +167,12 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
       ++count;
     }
     if (count == 0) continue;
-    mean[j] = sum / n;
-    if (in_search(j) && (line < 0 || mean[j] > mean[line])) line = j;
+    if (line < 0 || sum / n > line_mean) {
+      line = j;
+      line_mean = sum / n;
+    }
   }
-  if (line < 0 || mean[line] < o.min_line_contrast) return cue;
+  if (line < 0 || line_mean < o.min_line_contrast) return cue;
   // One by one, the samples must show it too (a few dark blotches make no
   // line), within straightness_px, at half the contrast.
   int showing = 0;
@@ -197,7 +197,7 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
     }
     texture = std::max(texture, sum / n);
   }
-  if (showing >= o.min_coverage * n && mean[line] >= o.texture_ratio * texture) {
+  if (showing >= o.min_coverage * n && line_mean >= o.texture_ratio * texture) {
     cue.coverage = static_cast<double>(showing) / n;
     cue.offset_m = (line - steps) * 0.5 * metres_per_px;
     cue.seam = true;
