@@ -1,6 +1,7 @@
 // Random scene layouts: isolated boxes, heaps, pallets, and support parts.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -53,6 +54,23 @@ void SetRandomCamera(const Eigen::Vector3d& look_at, double dist_lo, double dist
   const double yaw = Uniform(rng, 0.0, 360.0);
   const double roll = Uniform(rng, -2.0, 2.0);
   scene->world_T_camera = LookAtCamera(look_at, distance, tilt, yaw, roll);
+}
+
+// Moves the camera back along its axis until every box corner is at least
+// placement.min_depth_m deep. Draws nothing, so the layout stays the seed's.
+void KeepBeyondNearRange(const CameraPlacement& placement, Scene* scene) {
+  if (placement.min_depth_m <= 0.0) return;
+  const Eigen::Isometry3d camera_T_world = scene->world_T_camera.inverse();
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const SceneBox& box : scene->boxes) {
+    for (const Eigen::Vector3d& corner : BoxCorners(box.dims, camera_T_world * box.world_T_box)) {
+      nearest = std::min(nearest, corner.z());
+    }
+  }
+  if (nearest < placement.min_depth_m) {
+    scene->world_T_camera.translation() -=
+        (placement.min_depth_m - nearest) * scene->world_T_camera.linear().col(2);
+  }
 }
 
 // All corners in front of the camera and at least margin_px inside the image.
@@ -232,6 +250,7 @@ Scene MakeIsolatedScene(const BoxDims& dims, int num_boxes, uint32_t seed,
     if (scene.boxes.size() > best.boxes.size() || attempt == 0) best = scene;
     if (static_cast<int>(best.boxes.size()) >= num_boxes) break;
   }
+  KeepBeyondNearRange(placement, &best);
   return best;
 }
 
@@ -262,6 +281,7 @@ Scene MakeHeapScene(const BoxDims& dims, int num_boxes, uint32_t seed,
   const CameraRange range = Range(placement, 1.0, 1.5, 25.0);
   SetRandomCamera(Eigen::Vector3d(c.x(), c.y(), mean_z), range.lo, range.hi, range.tilt, rng,
                   &scene);
+  KeepBeyondNearRange(placement, &scene);
   return scene;
 }
 
@@ -340,6 +360,7 @@ Scene MakeDistractorPalletScene(const BoxDims& dims, int rows, int cols, int lay
       box = {other, pose, false};
     }
   }
+  KeepBeyondNearRange(placement, &scene);
   return scene;
 }
 

@@ -163,10 +163,16 @@ struct CameraPlacement {
   double min_distance_m = -1.0;
   double max_distance_m = -1.0;
   double max_tilt_deg = -1.0;
+  // Every box corner at least this deep in the camera frame: the camera backs
+  // off along its axis until it is, as a cell is laid out with the tallest
+  // box inside the sensor's working range (a heap's top box 0.3 m above the
+  // look-at point was nearer than a stereo camera's range and returned no
+  // depth at all). Metres; -1: no limit.
+  double min_depth_m = -1.0;
 };
 // A placement fit for a sensor's working range: kinect keeps the defaults;
-// stereo 1.3-2.0 m (look-at point to camera), tilt 0-20 deg; tof 1.0-1.8 m,
-// tilt 0-20 deg.
+// stereo 1.3-2.0 m (look-at point to camera), tilt 0-20 deg, every box at
+// least 5 cm beyond the near end of its range; tof 1.0-1.8 m, tilt 0-20 deg.
 CameraPlacement SensorPlacement(SensorKind kind, const CameraIntrinsics& intrinsics);
 
 // Scene builders. The seed fixes the layout, the camera and the noise.

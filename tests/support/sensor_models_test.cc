@@ -126,11 +126,54 @@ TEST(SensorModelsTest, StereoDropsDepthOutsideItsWorkingRange) {
   }
 }
 
+// A cell puts its tallest box inside the camera's range: the stereo placement
+// backs the camera off until every corner is 5 cm beyond the near end, so the
+// top of a heap returns depth. The layout is the seed's either way; only the
+// camera moves, along its axis.
+TEST(SensorModelsTest, StereoPlacementKeepsEveryBoxBeyondTheNearRange) {
+  const CameraIntrinsics k = *SensorIntrinsics(SensorKind::kStereo);
+  const CameraPlacement stereo = SensorPlacement(SensorKind::kStereo, k);
+  CameraPlacement unlimited = stereo;
+  unlimited.min_depth_m = -1.0;
+  int moved = 0;
+  for (uint32_t seed = 1; seed <= 12; ++seed) {
+    const Scene kept = MakeHeapScene(kCartonS, 13, seed, stereo);
+    const Scene free = MakeHeapScene(kCartonS, 13, seed, unlimited);
+    ASSERT_EQ(kept.boxes.size(), free.boxes.size());
+    double nearest_kept = 1e9, nearest_free = 1e9;
+    for (size_t i = 0; i < kept.boxes.size(); ++i) {
+      EXPECT_TRUE(kept.boxes[i].world_T_box.isApprox(free.boxes[i].world_T_box));
+      for (const Eigen::Vector3d& c : BoxCorners(
+               kept.boxes[i].dims, kept.world_T_camera.inverse() * kept.boxes[i].world_T_box)) {
+        nearest_kept = std::min(nearest_kept, c.z());
+      }
+      for (const Eigen::Vector3d& c : BoxCorners(
+               free.boxes[i].dims, free.world_T_camera.inverse() * free.boxes[i].world_T_box)) {
+        nearest_free = std::min(nearest_free, c.z());
+      }
+    }
+    EXPECT_GE(nearest_kept, StereoOptions{}.min_range_m + 0.05 - 1e-9) << seed;
+    EXPECT_TRUE(kept.world_T_camera.linear().isApprox(free.world_T_camera.linear()));
+    if (nearest_free < stereo.min_depth_m) {
+      ++moved;
+      // Backed off along the optical axis by exactly the shortfall.
+      const Eigen::Vector3d shift =
+          free.world_T_camera.translation() - kept.world_T_camera.translation();
+      EXPECT_NEAR(shift.dot(free.world_T_camera.linear().col(2)), stereo.min_depth_m - nearest_free,
+                  1e-9);
+    } else {
+      EXPECT_TRUE(kept.world_T_camera.isApprox(free.world_T_camera)) << seed;
+    }
+  }
+  EXPECT_GT(moved, 0);  // heaps of 13 cartons do reach into the near range
+}
+
 // Two cartons 2 mm apart: the crack between them shows the floor to exact
 // rays, but not in stereo depth; in colour the seam is darker than the faces.
 TEST(SensorModelsTest, StereoFillsTheSeamBetweenTouchingBoxesAndColourShowsIt) {
   const double gap = 0.002, height = 1.8;
-  const Scene scene = TopDown(SensorKind::kStereo, height, {-0.5 * (kCartonS.l + gap), 0.5 * (kCartonS.l + gap)});
+  const Scene scene =
+      TopDown(SensorKind::kStereo, height, {-0.5 * (kCartonS.l + gap), 0.5 * (kCartonS.l + gap)});
   const RenderedScene r = Render(scene, Sensor(SensorKind::kStereo, true));
   const CameraIntrinsics& cam = r.camera;
   const double z_top = height - kCartonS.h;

@@ -84,6 +84,7 @@ CameraPlacement SensorPlacement(SensorKind kind, const CameraIntrinsics& intrins
     p.min_distance_m = 1.3;
     p.max_distance_m = 2.0;
     p.max_tilt_deg = 20.0;
+    p.min_depth_m = StereoOptions{}.min_range_m + 0.05;
   } else if (kind == SensorKind::kTimeOfFlight) {
     p.min_distance_m = 1.0;
     p.max_distance_m = 1.8;
