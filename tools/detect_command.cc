@@ -64,6 +64,8 @@ constexpr char kHelp[] =
     "  --level_check M      a box whose top is level with a box beside it but whose\n"
     "                       bottom would lie more than M below that one's is taken\n"
     "                       out (0.05; 0: off)\n"
+    "  --turned_check BOOL  a box with a side not measured is taken out when its face\n"
+    "                       turned a quarter at a measured corner is a box too (true)\n"
     "  --layer_plane DEG    boxes side by side on one plane (a layer) take the plane\n"
     "                       fitted through all their faces when within DEG of it (12;\n"
     "                       0: every box keeps its own face's plane)\n"
@@ -148,6 +150,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("layer_check", &options.faces.check_layer_tiling),
         args.SetBool("floor_check", &options.floor_check),
         args.SetDouble("level_check", &options.max_below_neighbours_m),
+        args.SetBool("turned_check", &options.turned_check),
         args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
         args.SetDouble("layer_adopt", &options.layer_plane.adopt_angle_deg),
         args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
@@ -257,6 +260,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "layer_check",
                                                        "floor_check",
                                                        "level_check",
+                                                       "turned_check",
                                                        "layer_plane",
                                                        "layer_adopt",
                                                        "seam_colour",

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <thread>
@@ -281,6 +282,52 @@ bool CheckLayers(const DepthImage& depth, const DetectorOptions& options,
         "one of them) and it is none of them: a strip of a face cut by a false seam, or a box "
         "turned across the layer",
         static_cast<int>(faces.layers[layer[i]].tiles.size()));
+  });
+}
+
+// DetectorOptions::turned_check: a box whose face reads as well turned a
+// quarter at one of its measured corners is taken out. `cleared` holds the
+// boxes checked and kept before (the checks run in rounds), not judged
+// again. True when a box was taken out.
+bool CheckTurnedReadings(const internal::HypothesisJudge& judge, const DetectorOptions& options,
+                         std::vector<DetectedBox>* boxes,
+                         std::vector<std::array<SideKind, 4>>* sides,
+                         std::vector<DeclinedCandidate>* declined,
+                         std::vector<Eigen::Isometry3d>* cleared) {
+  auto measured = [](SideKind k) { return k == SideKind::kFree || k == SideKind::kSeam; };
+  return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
+    const DetectedBox& box = (*boxes)[i];
+    const std::array<SideKind, 4>& s = (*sides)[i];
+    if (std::all_of(s.begin(), s.end(), measured)) return "";
+    const int axis_n = static_cast<int>(box.grasp_face) / 2;
+    const int axis_a = (axis_n + 1) % 3, axis_b = (axis_n + 2) % 3;
+    const double A = options.box[axis_a], B = options.box[axis_b];
+    if (std::abs(A - B) < 0.02) return "";
+    const Eigen::Isometry3d& T = box.camera_T_box;
+    for (const Eigen::Isometry3d& c : *cleared) {
+      if ((c.translation() - T.translation()).norm() < 1e-4 && c.linear().isApprox(T.linear())) {
+        return "";
+      }
+    }
+    const Eigen::Matrix3d R = T.linear();
+    Eigen::Isometry3d turned = T;
+    turned.linear() =
+        R *
+        Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::Unit(axis_n)).toRotationMatrix();
+    for (double sa : {1.0, -1.0}) {
+      for (double sb : {1.0, -1.0}) {
+        if (!measured(s[sa > 0 ? 0 : 1]) || !measured(s[sb > 0 ? 2 : 3])) continue;
+        // Flush with this corner: B along a, A along b.
+        turned.translation() =
+            T.translation() + 0.5 * (A - B) * (sa * R.col(axis_a) - sb * R.col(axis_b));
+        if (judge.JudgeAlone(turned)) {
+          return "its face reads as well turned a quarter at one of its corners (a line in a face "
+                 "taken for a seam?): declined as ambiguous";
+        }
+      }
+    }
+    cleared->push_back(T);
+    return "";
   });
 }
 
@@ -681,6 +728,7 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
   acceptance->AcceptAll();
   const std::optional<FloorPlane> floor =
       options.floor_check ? FindFloor(f.depth, options, faces) : std::nullopt;
+  std::vector<Eigen::Isometry3d> cleared;  // CheckTurnedReadings
   auto check = [&] {
     const bool floor_removed =
         floor && CheckFloor(*floor, options, &det->boxes, acceptance->sides_of(), declined);
@@ -690,7 +738,10 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
     const bool level_removed =
         options.max_below_neighbours_m > 0.0 &&
         CheckStandsLevel(options, &det->boxes, acceptance->sides_of(), declined);
-    return floor_removed || layer_removed || level_removed;
+    const bool turned_removed =
+        options.turned_check && CheckTurnedReadings(*judge, options, &det->boxes,
+                                                    acceptance->sides_of(), declined, &cleared);
+    return floor_removed || layer_removed || level_removed || turned_removed;
   };
   for (int round = 0; round < 3 && check(); ++round) {
     for (const LayerTiles& layer : faces.layers) {

@@ -101,6 +101,13 @@ struct DetectorOptions {
   // faces (a smaller box in a layer of flat cartons read as a carton on
   // end). 0 turns the check off. Metres.
   double max_below_neighbours_m = 0.05;
+  // A box with a side its refinement did not measure (tiled, running on,
+  // hidden) is taken out when its grasp face turned a quarter about its
+  // normal, at one of its corners between two measured sides (free or a
+  // seam), is judged a box too: two readings of one face that the evidence
+  // cannot separate (a tape edge taken for a seam makes a carton turned
+  // across two). Faces whose sides differ by less than 2 cm are skipped.
+  bool turned_check = true;
   // How far a real box may be off its nominal size (bulge, sag, crushed
   // corners) and still be the box. Unset keeps each stage's own tolerance
   // (pose.length_tolerance_m 0.025, acceptance.extent_tolerance_m 0.025,

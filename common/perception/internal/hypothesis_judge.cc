@@ -214,6 +214,16 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
   return out;
 }
 
+std::optional<Candidate> HypothesisJudge::JudgeAlone(const Eigen::Isometry3d& camera_T_box) const {
+  Candidate c;
+  bool refined = false;
+  std::string reason;
+  if (!EvaluateOne(Proposal{camera_T_box, 0, {}, false}, &c, &refined, &reason)) {
+    return std::nullopt;
+  }
+  return c;
+}
+
 bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refined,
                                   std::string* reason) const {
   Candidate& cand = *out;

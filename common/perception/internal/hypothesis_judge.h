@@ -67,6 +67,9 @@ class HypothesisJudge {
   // Hypotheses that got as far as refinement and failed are kept, with the
   // reason, in declined().
   std::vector<Candidate> Evaluate(int threads);
+  // Judges one pose now, outside the queue: no duplicate is dropped and
+  // nothing is recorded. The accepted candidate, or nothing.
+  std::optional<Candidate> JudgeAlone(const Eigen::Isometry3d& camera_T_box) const;
 
   // A neighbour declined only because a side of its face runs on flat,
   // with a seam on another side: what it would have proposed as
