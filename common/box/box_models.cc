@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
+#include "common/validation/range_check.h"
 
 namespace cornerpose {
 namespace {
@@ -30,7 +31,8 @@ absl::StatusOr<BoxDims> BoxModelByName(absl::string_view name) {
   std::string known;
   for (const auto& [model, dims] : kModels)
     absl::StrAppend(&known, known.empty() ? "" : ", ", model);
-  return absl::NotFoundError(absl::StrCat("unknown box model '", name, "' (known: ", known, ")"));
+  return absl::NotFoundError(
+      absl::StrCat("unknown box model ", QuotedName(name), " (known: ", known, ")"));
 }
 
 absl::StatusOr<BoxDims> ResolveBoxModel(absl::string_view name, const BoxModels& models) {

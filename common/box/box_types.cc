@@ -14,6 +14,12 @@ absl::Status BoxDims::Validate() const {
       return absl::InvalidArgumentError(
           absl::StrCat("box size ", names[i], "=", sides[i], " m must be positive"));
     }
+    // Below this no depth camera resolves a box, and the detector's radii
+    // derived from the box round to nothing.
+    if (sides[i] < 0.005) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("box size ", names[i], "=", sides[i], " m is below the 5 mm limit"));
+    }
     if (sides[i] > 10.0) {
       return absl::InvalidArgumentError(
           absl::StrCat("box size ", names[i], "=", sides[i], " m is above the 10 m limit"));

@@ -24,6 +24,10 @@ namespace cornerpose {
 // (DetectorOptions::max_points) and by the wire library before it unpacks
 // one. Count.
 inline constexpr int kMaxPoints = 20'000'000;
+// An unorganized cloud is laid onto its camera's pixel grid: at most this
+// many pixels (a 2048 x 2048 sensor; depth cameras are 1 MP or less, and
+// stereo ones up to 2.3 MP), whatever the number of points. Count.
+inline constexpr int64_t kMaxUnorganizedGridPixels = 2048 * 2048;
 
 struct AcceptanceOptions {
   // Share of the box's unoccluded rendered pixels the depth confirms. Unitless.

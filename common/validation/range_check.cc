@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 
 namespace cornerpose {
@@ -27,6 +28,12 @@ absl::Status CheckPositive(absl::string_view field, double value, double hi) {
 absl::Status CheckAtLeast(absl::string_view field, double value, double lo) {
   if (std::isfinite(value) && value >= lo) return absl::OkStatus();
   return absl::InvalidArgumentError(absl::StrCat(field, " must be >= ", lo, ", got ", value));
+}
+
+std::string QuotedName(absl::string_view name, size_t max_bytes) {
+  if (name.size() <= max_bytes) return absl::StrCat("'", absl::CHexEscape(name), "'");
+  return absl::StrCat("'", absl::CHexEscape(name.substr(0, max_bytes)), "...' (", name.size(),
+                      " bytes)");
 }
 
 }  // namespace cornerpose

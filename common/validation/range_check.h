@@ -7,6 +7,7 @@
 #include <concepts>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <type_traits>
 
 #include "absl/status/status.h"
@@ -32,5 +33,11 @@ absl::Status CheckPositive(absl::string_view field, double value,
 
 // OK when value >= lo.
 absl::Status CheckAtLeast(absl::string_view field, double value, double lo);
+
+// A caller's name (a source, a box model) as an error message quotes it:
+// escaped (C-style: no raw control bytes or invalid UTF-8 in a status) and
+// at most max_bytes of it, then how long it was. A status travels in gRPC
+// metadata, which a client refuses beyond 8 KiB.
+std::string QuotedName(absl::string_view name, size_t max_bytes = 64);
 
 }  // namespace cornerpose

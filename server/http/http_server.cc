@@ -10,6 +10,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
+#include "common/validation/range_check.h"
 #include "server/http/frame_encoding.h"
 #include "server/http/view_json.h"
 #include "web/web_assets.h"
@@ -99,16 +100,16 @@ absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(
   absl::StatusOr<BoxDims> view_box = ResolveBoxModel(options.view_box, *box_models);
   if (!view_box.ok()) view_box = ParseBoxDims(options.view_box);
   if (!view_box.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "view_box '", options.view_box, "' is neither a box model nor L,B,H in metres"));
+    return absl::InvalidArgumentError(absl::StrCat("view_box '", options.view_box,
+                                                   "' is neither a box model nor L,B,H in metres"));
   }
   const size_t colon = options.listen_address.rfind(':');
   int port = -1;
   if (colon == std::string::npos ||
       !absl::SimpleAtoi(options.listen_address.substr(colon + 1), &port) || port < 0 ||
       port > 65535) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "http_listen '", options.listen_address, "' is not host:port (port 0 to 65535)"));
+    return absl::InvalidArgumentError(absl::StrCat("http_listen '", options.listen_address,
+                                                   "' is not host:port (port 0 to 65535)"));
   }
   std::string host = options.listen_address.substr(0, colon);
   // [::1]:8080 -> ::1
@@ -264,21 +265,21 @@ void HttpServer::AddRoutes() {
     SendJson(res, 200, cell_ != nullptr ? cell_->StatusJson() : R"({"configured":false})");
   });
 
-  http.Get(R"(/api/sources/([^/]+)/latest)",
-           [this](const httplib::Request& req, httplib::Response& res) {
-             SourceView* view = FindView(req.matches[1]);
-             if (view == nullptr) {
-               SendError(res, 404, absl::StrCat("unknown source '", req.matches[1].str(), "'"));
-               return;
-             }
-             absl::StatusOr<std::shared_ptr<const ViewDetection>> d =
-                 view->NextDetection(req.get_param_value("box"), 0, kLatestWait);
-             if (!d.ok()) {
-               SendError(res, d.status());
-               return;
-             }
-             SendJson(res, 200, ViewDetectionJson(**d));
-           });
+  http.Get(R"(/api/sources/([^/]+)/latest)", [this](const httplib::Request& req,
+                                                    httplib::Response& res) {
+    SourceView* view = FindView(req.matches[1]);
+    if (view == nullptr) {
+      SendError(res, 404, absl::StrCat("unknown source ", QuotedName(req.matches[1].str())));
+      return;
+    }
+    absl::StatusOr<std::shared_ptr<const ViewDetection>> d =
+        view->NextDetection(req.get_param_value("box"), 0, kLatestWait);
+    if (!d.ok()) {
+      SendError(res, d.status());
+      return;
+    }
+    SendJson(res, 200, ViewDetectionJson(**d));
+  });
 
   http.Get(R"(/api/sources/([^/]+)/frames/(\d+)/(image\.png|cloud\.bin))",
            [this](const httplib::Request& req, httplib::Response& res) {
@@ -305,10 +306,10 @@ void HttpServer::AddRoutes() {
            });
 
   http.Get(R"(/api/sources/([^/]+)/events)", [this](const httplib::Request& req,
-                                                     httplib::Response& res) {
+                                                    httplib::Response& res) {
     SourceView* view = FindView(req.matches[1]);
     if (view == nullptr) {
-      SendError(res, 404, absl::StrCat("unknown source '", req.matches[1].str(), "'"));
+      SendError(res, 404, absl::StrCat("unknown source ", QuotedName(req.matches[1].str())));
       return;
     }
     const std::string box = req.get_param_value("box");

@@ -3,6 +3,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/validation/range_check.h"
 #include "common/wire/box_wire.h"
 #include "common/wire/cloud_wire.h"
 #include "common/wire/detector_wire.h"
@@ -57,6 +58,16 @@ absl::StatusOr<PointCloud> CloudFromRequest(const v1::DetectRequest& request) {
   switch (request.input_case()) {
     case v1::DetectRequest::kCloud:
       cloud = wire::CloudFromProto(request.cloud());
+      // An organized cloud is its own camera's grid: intrinsics of another
+      // size name another camera (they were ignored without a word).
+      if (cloud.ok() && cloud->organized() && request.has_intrinsics() &&
+          (request.intrinsics().width() != static_cast<uint32_t>(cloud->width) ||
+           request.intrinsics().height() != static_cast<uint32_t>(cloud->height))) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("intrinsics image size ", request.intrinsics().width(), " x ",
+                         request.intrinsics().height(), " differs from the organized cloud's ",
+                         cloud->width, " x ", cloud->height));
+      }
       break;
     case v1::DetectRequest::kDepthImage:
       cloud = wire::CloudFromDepthImage(request.depth_image(),
@@ -65,7 +76,7 @@ absl::StatusOr<PointCloud> CloudFromRequest(const v1::DetectRequest& request) {
     case v1::DetectRequest::kSource:
       // The service grabs from its own sources before calling this; a name
       // that reaches here is not one of them.
-      return absl::NotFoundError(absl::StrCat("unknown source '", request.source(), "'"));
+      return absl::NotFoundError(absl::StrCat("unknown source ", QuotedName(request.source())));
     case v1::DetectRequest::INPUT_NOT_SET:
       return absl::InvalidArgumentError("request has no input: set cloud, depth_image or source");
   }

@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
+#include "common/validation/range_check.h"
 #include "server/service/detect_request.h"
 #include "server/service/detect_response.h"
 #include "server/service/status_mapping.h"
@@ -54,7 +55,7 @@ absl::StatusOr<Frame> GrabFromSource(
     absl::Time deadline) {
   auto it = sources.find(name);
   if (it == sources.end()) {
-    return absl::NotFoundError(absl::StrCat("unknown source '", name, "'"));
+    return absl::NotFoundError(absl::StrCat("unknown source ", QuotedName(name)));
   }
   const absl::Duration until_deadline = deadline - absl::Now();
   return it->second->Grab(std::min(kMaxFrameWait, until_deadline));
@@ -213,7 +214,8 @@ grpc::ServerWriteReactor<v1::DetectResponse>* PerceptionServiceImpl::StreamDetec
   if (!options.ok()) return refuse(options.status());
   auto it = sources_.find(request->source());
   if (it == sources_.end()) {
-    return refuse(absl::NotFoundError(absl::StrCat("unknown source '", request->source(), "'")));
+    return refuse(
+        absl::NotFoundError(absl::StrCat("unknown source ", QuotedName(request->source()))));
   }
   // Streams whose requests differ only in what the response carries share
   // their detections.

@@ -215,5 +215,28 @@ TEST(InputBoundsTest, KdTreePathRefusesMoreThanItsCap) {
               HasSubstr("has 1000001 finite points; the k-d tree path scores at most 1000000"));
 }
 
+// Found by an adversarial check of the server: 20 000 unorganized points
+// sent with a 16384 x 16384 camera were laid onto a grid of 268 M pixels
+// (16 s and 4 GB, past any deadline). The grid's size is refused at once,
+// naming the intrinsics; a 2048 x 2048 camera is still laid onto.
+TEST(InputBoundsTest, AnUnorganizedCloudsCameraGridIsBounded) {
+  PointCloud cloud;
+  for (int i = 0; i < 20000; ++i) {
+    cloud.xyz.emplace_back(0.001f * (i % 200) - 0.1f, 0.001f * (i / 200) - 0.05f, 1.2f);
+  }
+  cloud.width = static_cast<int>(cloud.xyz.size());
+  cloud.height = 1;
+  DetectorOptions options;
+  options.box = BoxDims{0.30, 0.20, 0.15};
+  options.camera = CameraIntrinsics{16384, 16384, 525.0, 525.0, 8192.0, 8192.0};
+  const absl::StatusOr<Detection> refused = DetectBoxes(cloud, options);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(refused.status().message()),
+              HasSubstr("intrinsics image size 16384 x 16384 is above the 4194304 pixels"));
+  options.camera = CameraIntrinsics{2048, 2048, 525.0, 525.0, 1024.0, 1024.0};
+  const absl::StatusOr<Detection> laid = DetectBoxes(cloud, options);
+  EXPECT_TRUE(laid.ok()) << laid.status();
+}
+
 }  // namespace
 }  // namespace cornerpose::testing

@@ -86,6 +86,8 @@ TEST(DetectorOptionsFromRequestTest, RefusedBoxes) {
       {WithBox(0.3, 0.0, 0.15), "box size b=0 m must be positive"},
       {WithBox(-0.3, 0.2, 0.15), "box size l=-0.3 m must be positive"},
       {WithBox(0.3, 0.2, 11), "above the 10 m limit"},
+      // A tiny box named the edge radius derived from it (rounded to 0).
+      {WithBox(0.3, 1e-9, 0.15), "box size b=1e-09 m is below the 5 mm limit"},
       {unknown, "unknown box model 'crate'"},
       {v1::DetectRequest(), "request has no box size"},
   };
@@ -151,6 +153,29 @@ TEST(DetectorOptionsFromRequestTest, StreamRequestsResolveTheSameWay) {
   absl::Status s = DetectorOptionsFromRequest(request, {}).status();
   EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(s.message(), HasSubstr("request has no box size"));
+}
+
+// An organized cloud is its camera's grid: intrinsics of another size were
+// ignored without a word; of its own size (or none) they are fine.
+TEST(CloudFromRequestTest, IntrinsicsOfAnotherSizeThanAnOrganizedCloudAreRefused) {
+  v1::DetectRequest request;
+  v1::PointCloud* cloud = request.mutable_cloud();
+  const float xyz[12] = {0, 0, 1, 0.1f, 0, 1, 0, 0.1f, 1, 0.1f, 0.1f, 1};
+  cloud->set_xyz(std::string(reinterpret_cast<const char*>(xyz), sizeof(xyz)));
+  cloud->set_width(2);
+  cloud->set_height(2);
+  EXPECT_TRUE(CloudFromRequest(request).ok());
+  v1::CameraIntrinsics* k = request.mutable_intrinsics();
+  k->set_width(2);
+  k->set_height(2);
+  k->set_fx(500);
+  k->set_fy(500);
+  EXPECT_TRUE(CloudFromRequest(request).ok());
+  k->set_width(4);
+  const absl::Status s = CloudFromRequest(request).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(),
+              HasSubstr("intrinsics image size 4 x 2 differs from the organized cloud's 2 x 2"));
 }
 
 TEST(CloudFromRequestTest, ColourImageBecomesTheCloudsColour) {

@@ -285,6 +285,10 @@ TEST_F(ServerTest, BadInputGetsTheRightCodeAndTheServerKeepsServing) {
     r.set_source("camera_7");
     r.set_box_model("carton_s");
     cases.push_back({"unknown source", r, grpc::StatusCode::NOT_FOUND, "unknown source"});
+    // A name past gRPC's 8 KiB metadata limit came back whole in the
+    // message, and the client saw RESOURCE_EXHAUSTED instead of NOT_FOUND.
+    r.set_source(std::string(10000, 'x') + "\n");
+    cases.push_back({"long source name", r, grpc::StatusCode::NOT_FOUND, "...' (10001 bytes)"});
   }
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);

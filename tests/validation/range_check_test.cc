@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <string>
 
 namespace cornerpose {
 namespace {
@@ -37,6 +38,14 @@ TEST(CheckPositiveTest, ZeroIsOutAndTheUpperBoundIsSaidWhenThereIsOne) {
 TEST(CheckAtLeastTest, BelowIsOut) {
   EXPECT_TRUE(CheckAtLeast("margin", 0.0, 0.0).ok());
   EXPECT_EQ(CheckAtLeast("margin", -0.1, 0.0).message(), "margin must be >= 0, got -0.1");
+}
+
+TEST(QuotedNameTest, EscapesAndShortensWhatACallerNamed) {
+  EXPECT_EQ(QuotedName("cell_1"), "'cell_1'");
+  EXPECT_EQ(QuotedName(std::string("c\xff\nx\0y", 6)), "'c\\xff\\nx\\x00y'");
+  const std::string quoted = QuotedName(std::string(10000, 'a'));
+  EXPECT_LT(quoted.size(), 100u);
+  EXPECT_EQ(quoted, "'" + std::string(64, 'a') + "...' (10000 bytes)");
 }
 
 }  // namespace

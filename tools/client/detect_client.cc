@@ -63,7 +63,6 @@ absl::Status Detect(const CommandArgs& args) {
     absl::StatusOr<CameraIntrinsics> parsed = ParseIntrinsics(*k);
     if (!parsed.ok()) return parsed.status();
     intrinsics = *parsed;
-    *request.mutable_intrinsics() = wire::ToProto(*parsed);
   }
   if (cloud_path) {
     LoadOptions load;
@@ -72,12 +71,17 @@ absl::Status Detect(const CommandArgs& args) {
     if (!loaded.ok()) return loaded.status();
     cloud = *std::move(loaded);
     *request.mutable_cloud() = wire::CloudToProto(cloud);
+    // The camera of an unorganized cloud; an organized one (a depth image
+    // made into one here) is its own camera's grid.
+    if (intrinsics && !cloud.organized())
+      *request.mutable_intrinsics() = wire::ToProto(*intrinsics);
   } else {
     request.set_source(*source);
     request.set_include_cloud(common->outputs.need_cloud());
   }
 
-  absl::StatusOr<std::shared_ptr<grpc::Channel>> made = MakeChannel(common->server, TlsFilesFromArgs(args));
+  absl::StatusOr<std::shared_ptr<grpc::Channel>> made =
+      MakeChannel(common->server, TlsFilesFromArgs(args));
   if (!made.ok()) return made.status();
   std::shared_ptr<grpc::Channel> channel = *std::move(made);
   std::unique_ptr<v1::PerceptionService::Stub> stub = v1::PerceptionService::NewStub(channel);
@@ -116,8 +120,8 @@ int RunClientDetect(const std::vector<std::string>& argv) {
   if (PrintHelpIfAsked(argv, HelpWithTls(kHelp).c_str())) return 0;
   absl::StatusOr<CommandArgs> args =
       ParseCommandArgs(argv,
-                       WithTlsOptions({"server", "cloud", "source", "box", "intrinsics", "json", "ply", "png",
-                        "edges", "deadline_ms"}),
+                       WithTlsOptions({"server", "cloud", "source", "box", "intrinsics", "json",
+                                       "ply", "png", "edges", "deadline_ms"}),
                        {"quiet"}, {"server", "box"});
   if (args.ok() && args->Get("cloud").has_value() == args->Get("source").has_value()) {
     args = absl::InvalidArgumentError("give exactly one of --cloud FILE and --source NAME");
