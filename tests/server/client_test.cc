@@ -102,6 +102,35 @@ TEST(ClientTest, UnreachableServerFailsQuicklyWithExitCodeOne) {
   EXPECT_THAT(err, HasSubstr("cannot reach server"));
 }
 
+// A box model only the server's configuration names: the client sends the
+// name (it refused names it did not know itself), and draws its outputs with
+// the size the server resolved it to.
+TEST(ClientTest, DetectSendsABoxModelOnlyTheServerKnows) {
+  const testing::RenderedScene scene =
+      testing::Render(testing::MakeIsolatedScene({0.30, 0.20, 0.15}, 2, 1));
+  const std::string cloud_path = TempPath("client_test_model.pcd");
+  const std::string json_path = TempPath("client_test_model.json");
+  std::filesystem::remove(json_path);
+  ASSERT_TRUE(SavePcd(cloud_path, scene.cloud).ok());
+  server::ServerOptions options;
+  options.listen_address = "127.0.0.1:0";
+  options.box_models["tote_carton"] = {0.30, 0.20, 0.15};
+  absl::StatusOr<std::unique_ptr<server::RunningServer>> running = server::StartServer(options);
+  ASSERT_TRUE(running.ok()) << running.status();
+  const std::string address = "127.0.0.1:" + std::to_string((*running)->port());
+  ASSERT_EQ(RunClient({"detect", "--server", address, "--cloud", cloud_path, "--box", "tote_carton",
+                       "--json", json_path, "--deadline_ms", "120000"}),
+            0);
+  std::ifstream in(json_path);
+  const nlohmann::json json = nlohmann::json::parse(in);
+  EXPECT_GT(json["boxes"].size(), 0u);
+  EXPECT_NEAR(json["box_dims"][0].get<double>(), 0.30, 1e-9);
+  // A name neither knows is the server's NOT_FOUND-as-invalid answer.
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(RunClient({"detect", "--server", address, "--cloud", cloud_path, "--box", "crate"}), 1);
+  EXPECT_THAT(::testing::internal::GetCapturedStderr(), HasSubstr("unknown box model 'crate'"));
+}
+
 TEST(ClientTest, BadUsageIsExitCodeTwo) {
   ::testing::internal::CaptureStderr();
   EXPECT_EQ(RunClient({"detect", "--cloud", "x.pcd"}), 2);

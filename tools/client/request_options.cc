@@ -13,8 +13,13 @@ absl::StatusOr<ClientRequestOptions> ParseClientRequestOptions(const CommandArgs
   out.server = args.Get("server").value_or("");
   out.box_text = args.Get("box").value_or("");
   absl::StatusOr<BoxDims> box = ParseBoxDims(out.box_text);
-  if (!box.ok()) return box.status();
-  out.box = *box;
+  if (box.ok()) {
+    out.box = *box;
+  } else if (out.box_text.empty() || out.box_text.find(',') != std::string::npos) {
+    return box.status();
+  }
+  // Otherwise a name only the server knows (its box_models): it resolves it,
+  // and DetectResponse.box_dims_used gives the outputs its size.
   if (auto d = args.Get("deadline_ms")) {
     if (!absl::SimpleAtoi(*d, &out.deadline_ms) || out.deadline_ms <= 0) {
       return absl::InvalidArgumentError(
