@@ -209,5 +209,42 @@ TEST(HypothesisJudgeTest, ANeighbourWithNoSeamIsNoSteppingStone) {
   EXPECT_TRUE(judge.TakeSteppingStones().empty());
 }
 
+// A carton in a layer of touching ones with a small box standing over one
+// of its sides: three seams and a hidden side, no free one, so it is
+// declined "not boxed in by seams on all four". Proposed as a neighbour, it
+// is a stepping stone as one running on flat is: it lies in the layer, and
+// the cartons past it are still worth judging.
+TEST(HypothesisJudgeTest, ANeighbourNotBoxedInIsASteppingStone) {
+  Scene scene;
+  scene.world_T_camera = LookAtCamera(Eigen::Vector3d::Zero(), 1.3, 10.0, 20.0, 0.0);
+  auto add = [&](const BoxDims& dims, double x, double y, double z) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = Eigen::Vector3d(x, y, z);
+    scene.boxes.push_back({dims, pose, true});
+  };
+  const double gap = 0.004;
+  for (int i = -1; i <= 1; ++i) {
+    for (int j = -1; j <= 1; ++j) {
+      add(kCartonS, i * (kCartonS.l + gap), j * (kCartonS.b + gap), kCartonS.h / 2.0);
+    }
+  }
+  const BoxDims small{0.10, 0.10, 0.10};
+  add(small, (kCartonS.l + gap) / 2.0, 0.0, kCartonS.h + small.h / 2.0);
+  NoiseOptions noise;
+  noise.enabled = false;
+  const RenderedScene out = Render(scene, noise);
+  const DepthImage depth = MakeDepthImage(out.cloud, out.camera);
+  DetectorOptions o;
+  o.box = kCartonS;
+  internal::HypothesisJudge judge(depth, o);
+  judge.ProposeNeighbour(out.boxes.at(4).camera_T_box);  // the middle one
+  EXPECT_TRUE(judge.Evaluate(1).empty());
+  ASSERT_EQ(judge.declined().size(), 1u);
+  EXPECT_EQ(judge.declined()[0].reason, "no free side and not boxed in by seams on all four");
+  const auto stones = judge.TakeSteppingStones();
+  ASSERT_EQ(stones.size(), 1u);
+  EXPECT_EQ(stones[0].steps, 1);
+}
+
 }  // namespace
 }  // namespace cornerpose::testing

@@ -15,6 +15,7 @@ namespace {
 constexpr char kMovedTooFar[] = "refinement moved it too far: not this box";
 constexpr char kRunsOnFlat[] =
     "a side runs on flat with no seam (a bigger face, or a layer that does not tile uniquely)";
+constexpr char kNotBoxedIn[] = "no free side and not boxed in by seams on all four";
 
 }  // namespace
 
@@ -43,7 +44,7 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
   // boxed in on all four (by seams or whole tiles of its layer).
   if (measured < 2) return "fewer than two sides of the face measured";
   if (ref.free_sides < 1 && measured < 4) {
-    return "no free side and not boxed in by seams on all four";
+    return kNotBoxedIn;
   }
   // A side hidden under something may hide more face: keep the box only if
   // no bigger side of the box could stand in for this one there.
@@ -180,16 +181,18 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
     stats_.refined += refined[i];
     if (!accepted[i]) {
       // A stepping stone: a neighbour (of a box accepted, or within the
-      // allowed steps past declined ones) declined for a side on flat, with
-      // a seam on another side (it lies in a layer of touching boxes; a
-      // face running on flat everywhere else is a bigger face or the floor,
-      // and stepping on from it only costs time).
+      // allowed steps past declined ones) declined for a side on flat, or
+      // for seams on only some of its sides and no free one (a side hidden
+      // under the layer above), with a seam on another side (it lies in a
+      // layer of touching boxes; a face running on flat everywhere else is
+      // a bigger face or the floor, and stepping on from it only costs
+      // time).
       const Proposal& q = queue_[i];
       const std::array<SideKind, 4>& sides = results[i].refinement.sides;
       const bool seamed = std::any_of(sides.begin(), sides.end(), [](SideKind k) {
         return k == SideKind::kSeam || k == SideKind::kTiled;
       });
-      if (refined[i] && reasons[i] == kRunsOnFlat && seamed &&
+      if (refined[i] && (reasons[i] == kRunsOnFlat || reasons[i] == kNotBoxedIn) && seamed &&
           (q.neighbour || q.past_declined > 0) &&
           q.past_declined < options_.neighbour_steps_past_declined) {
         stepping_stones_.push_back({results[i].box, q.past_declined + 1});
