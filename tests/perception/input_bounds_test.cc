@@ -221,8 +221,10 @@ TEST(InputBoundsTest, KdTreePathRefusesMoreThanItsCap) {
 // naming the intrinsics; a 2048 x 2048 camera is still laid onto.
 TEST(InputBoundsTest, AnUnorganizedCloudsCameraGridIsBounded) {
   PointCloud cloud;
-  for (int i = 0; i < 20000; ++i) {
-    cloud.xyz.emplace_back(0.001f * (i % 200) - 0.1f, 0.001f * (i / 200) - 0.05f, 1.2f);
+  for (int row = 0; row < 100; ++row) {
+    for (int col = 0; col < 200; ++col) {
+      cloud.xyz.emplace_back(0.001f * col - 0.1f, 0.001f * row - 0.05f, 1.2f);
+    }
   }
   cloud.width = static_cast<int>(cloud.xyz.size());
   cloud.height = 1;
