@@ -300,27 +300,17 @@ bool CheckTurnedReadings(const internal::HypothesisJudge& judge, const DetectorO
     const std::array<SideKind, 4>& s = (*sides)[i];
     if (std::all_of(s.begin(), s.end(), measured)) return "";
     const int axis_n = static_cast<int>(box.grasp_face) / 2;
-    const int axis_a = (axis_n + 1) % 3, axis_b = (axis_n + 2) % 3;
-    const double A = options.box[axis_a], B = options.box[axis_b];
-    if (std::abs(A - B) < 0.02) return "";
+    if (std::abs(options.box[(axis_n + 1) % 3] - options.box[(axis_n + 2) % 3]) < 0.02) return "";
     const Eigen::Isometry3d& T = box.camera_T_box;
     for (const Eigen::Isometry3d& c : *cleared) {
       if ((c.translation() - T.translation()).norm() < 1e-4 && c.linear().isApprox(T.linear())) {
         return "";
       }
     }
-    const Eigen::Matrix3d R = T.linear();
-    Eigen::Isometry3d turned = T;
-    turned.linear() =
-        R *
-        Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::Unit(axis_n)).toRotationMatrix();
     for (double sa : {1.0, -1.0}) {
       for (double sb : {1.0, -1.0}) {
         if (!measured(s[sa > 0 ? 0 : 1]) || !measured(s[sb > 0 ? 2 : 3])) continue;
-        // Flush with this corner: B along a, A along b.
-        turned.translation() =
-            T.translation() + 0.5 * (A - B) * (sa * R.col(axis_a) - sb * R.col(axis_b));
-        if (judge.JudgeAlone(turned)) {
+        if (judge.JudgeAlone(internal::TurnedAtCorner(T, box.grasp_face, options.box, sa, sb))) {
           return "its face reads as well turned a quarter at one of its corners (a line in a face "
                  "taken for a seam?): declined as ambiguous";
         }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <optional>
 
 #include "absl/strings/str_format.h"
@@ -215,6 +216,20 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
   }
   queue_.clear();
   return out;
+}
+
+Eigen::Isometry3d TurnedAtCorner(const Eigen::Isometry3d& camera_T_box, BoxFace grasp,
+                                 const BoxDims& dims, double sa, double sb) {
+  const int axis_n = static_cast<int>(grasp) / 2;
+  const int axis_a = (axis_n + 1) % 3, axis_b = (axis_n + 2) % 3;
+  const double A = dims[axis_a], B = dims[axis_b];
+  const Eigen::Matrix3d R = camera_T_box.linear();
+  Eigen::Isometry3d turned = camera_T_box;
+  turned.linear() =
+      R * Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::Unit(axis_n)).toRotationMatrix();
+  // B along a, A along b, one corner in common.
+  turned.translation() += 0.5 * (A - B) * (sa * R.col(axis_a) - sb * R.col(axis_b));
+  return turned;
 }
 
 std::optional<Candidate> HypothesisJudge::JudgeAlone(const Eigen::Isometry3d& camera_T_box) const {

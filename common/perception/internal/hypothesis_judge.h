@@ -38,6 +38,12 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
 double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
                     BoxFace grasp, const AcceptanceOptions& o, std::string* reason = nullptr);
 
+// The box turned a quarter about its grasp face's normal, flush with the
+// face's corner at (sa, sb) (each +1 or -1 along the face's a and b axes):
+// the other way to read a face from one of its corners.
+Eigen::Isometry3d TurnedAtCorner(const Eigen::Isometry3d& camera_T_box, BoxFace grasp,
+                                 const BoxDims& dims, double sa, double sb);
+
 class HypothesisJudge {
  public:
   // A stopped `cancel` (may be null) leaves the rest of a queue unjudged.
