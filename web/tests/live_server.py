@@ -82,8 +82,11 @@ class LiveServer:
 
 def detect_count(cli, address: str, source: str, box: str, out: pathlib.Path) -> int:
     """Boxes a gRPC Detect on the source's newest frame finds (`cornerpose client detect`)."""
+    # A deadline well past the CLI's default 10 s: under a loaded test run the
+    # request may queue behind the web view's own detections.
     subprocess.run([str(cli), "client", "detect", "--server", address, "--source", source,
-                    "--box", box, "--json", str(out), "--quiet"], check=True, timeout=120)
+                    "--box", box, "--json", str(out), "--quiet", "--deadline_ms", "60000"],
+                   check=True, timeout=120)
     return len(json.loads(out.read_text())["boxes"])
 
 
