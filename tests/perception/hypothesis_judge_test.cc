@@ -13,25 +13,30 @@ namespace {
 
 constexpr BoxDims kCartonS{0.30, 0.20, 0.15};
 
-struct OneBox {
+struct RenderedDepth {
   RenderedScene out;
   DepthImage depth;
 };
 
+// The scene rendered without noise, and its depth image.
+RenderedDepth RenderNoiseFree(const Scene& scene) {
+  NoiseOptions noise;
+  noise.enabled = false;
+  RenderedDepth b{Render(scene, noise), {}};
+  b.depth = MakeDepthImage(b.out.cloud, b.out.camera);
+  return b;
+}
+
 // `cx`: the camera's principal point (a small one puts the box, which the
 // camera looks at, at the image's left edge).
-OneBox RenderOneBox(double cx = CameraIntrinsics{}.cx) {
+RenderedDepth RenderOneBox(double cx = CameraIntrinsics{}.cx) {
   Scene scene;
   scene.camera.cx = cx;
   scene.world_T_camera = LookAtCamera(Eigen::Vector3d::Zero(), 1.2, 10.0, 20.0, 0.0);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.translation().z() = kCartonS.h / 2.0;
   scene.boxes.push_back({kCartonS, pose, true});
-  NoiseOptions noise;
-  noise.enabled = false;
-  OneBox b{Render(scene, noise), {}};
-  b.depth = MakeDepthImage(b.out.cloud, b.out.camera);
-  return b;
+  return RenderNoiseFree(scene);
 }
 
 Eigen::Isometry3d Moved(const Eigen::Isometry3d& pose, double dx) {
@@ -41,7 +46,7 @@ Eigen::Isometry3d Moved(const Eigen::Isometry3d& pose, double dx) {
 }
 
 TEST(HypothesisJudgeTest, ADeclinedPoseIsJudgedOnceMoreFromAnotherStart) {
-  const OneBox b = RenderOneBox();
+  const RenderedDepth b = RenderOneBox();
   const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;
   for (const bool retry : {true, false}) {
     DetectorOptions o;
@@ -67,7 +72,7 @@ TEST(HypothesisJudgeTest, ADeclinedPoseIsJudgedOnceMoreFromAnotherStart) {
 }
 
 TEST(HypothesisJudgeTest, AnAcceptedPoseIsNotJudgedAgain) {
-  const OneBox b = RenderOneBox();
+  const RenderedDepth b = RenderOneBox();
   const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;
   DetectorOptions o;
   o.box = kCartonS;
@@ -89,7 +94,7 @@ TEST(HypothesisJudgeTest, AnAcceptedPoseIsNotJudgedAgain) {
 // u = -24 and its left side's upper quarter point at u = 3; at u = 30 the
 // whole left side is out.
 TEST(HypothesisJudgeTest, AFaceLeavingTheViewIsRefinedWhenItMayBeMeasuredThere) {
-  const OneBox out_a_side = RenderOneBox(/*cx=*/30.0);
+  const RenderedDepth out_a_side = RenderOneBox(/*cx=*/30.0);
   for (const bool may_leave : {true, false}) {
     DetectorOptions o;
     o.box = kCartonS;
@@ -99,7 +104,7 @@ TEST(HypothesisJudgeTest, AFaceLeavingTheViewIsRefinedWhenItMayBeMeasuredThere) 
     judge.Evaluate(1);
     EXPECT_EQ(judge.stats().refined, 0) << may_leave;
   }
-  const OneBox b = RenderOneBox(/*cx=*/64.0);
+  const RenderedDepth b = RenderOneBox(/*cx=*/64.0);
   const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;
   for (const bool may_leave : {true, false}) {
     DetectorOptions o;
@@ -134,10 +139,9 @@ TEST(HypothesisJudgeTest, ANeighbourRunningOnFlatIsASteppingStone) {
   add(BoxDims{0.40, kCartonS.b, kCartonS.h}, 0.35, 0.0);
   add(kCartonS, -0.3, kCartonS.b + 0.004);
   add(kCartonS, 0.0, kCartonS.b + 0.004);
-  NoiseOptions noise;
-  noise.enabled = false;
-  const RenderedScene out = Render(scene, noise);
-  const DepthImage depth = MakeDepthImage(out.cloud, out.camera);
+  const RenderedDepth rendered = RenderNoiseFree(scene);
+  const RenderedScene& out = rendered.out;
+  const DepthImage& depth = rendered.depth;
   const Eigen::Isometry3d& first = out.boxes.at(0).camera_T_box;
   const Eigen::Isometry3d& second = out.boxes.at(1).camera_T_box;
   auto runs_on_flat = [](const DeclinedCandidate& d) {
@@ -194,10 +198,9 @@ TEST(HypothesisJudgeTest, ANeighbourWithNoSeamIsNoSteppingStone) {
     pose.translation() = Eigen::Vector3d(x, 0.0, kCartonS.h / 2.0);
     scene.boxes.push_back({kCartonS, pose, true});
   }
-  NoiseOptions noise;
-  noise.enabled = false;
-  const RenderedScene out = Render(scene, noise);
-  const DepthImage depth = MakeDepthImage(out.cloud, out.camera);
+  const RenderedDepth rendered = RenderNoiseFree(scene);
+  const RenderedScene& out = rendered.out;
+  const DepthImage& depth = rendered.depth;
   DetectorOptions o;
   o.box = kCartonS;
   internal::HypothesisJudge judge(depth, o);
@@ -230,10 +233,9 @@ TEST(HypothesisJudgeTest, ANeighbourNotBoxedInIsASteppingStone) {
   }
   const BoxDims small{0.10, 0.10, 0.10};
   add(small, (kCartonS.l + gap) / 2.0, 0.0, kCartonS.h + small.h / 2.0);
-  NoiseOptions noise;
-  noise.enabled = false;
-  const RenderedScene out = Render(scene, noise);
-  const DepthImage depth = MakeDepthImage(out.cloud, out.camera);
+  const RenderedDepth rendered = RenderNoiseFree(scene);
+  const RenderedScene& out = rendered.out;
+  const DepthImage& depth = rendered.depth;
   DetectorOptions o;
   o.box = kCartonS;
   internal::HypothesisJudge judge(depth, o);
