@@ -156,9 +156,9 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
   // A faint line: the offset whose mean over the whole side is darkest (a
   // matched filter: the grain of cardboard or brick averages out, a faint
   // seam adds up). Samples out of view count as no line.
-  int line = -1;
-  double line_mean = 0.0;
-  for (int j = steps - search_steps; j <= steps + search_steps; ++j) {
+  // Offset j's valley averaged over the whole side (out of view: none), or
+  // nothing when no sample has it.
+  auto side_mean = [&](int j) -> std::optional<double> {
     double sum = 0.0;
     int count = 0;
     for (int i = 0; i < n; ++i) {
@@ -166,10 +166,16 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
       sum += at(i, j);
       ++count;
     }
-    if (count == 0) continue;
-    if (line < 0 || sum / n > line_mean) {
+    if (count == 0) return std::nullopt;
+    return sum / n;
+  };
+  int line = -1;
+  double line_mean = 0.0;
+  for (int j = steps - search_steps; j <= steps + search_steps; ++j) {
+    const std::optional<double> mean = side_mean(j);
+    if (mean && (line < 0 || *mean > line_mean)) {
       line = j;
-      line_mean = sum / n;
+      line_mean = *mean;
     }
   }
   if (line < 0 || line_mean < o.min_line_contrast) return cue;
@@ -191,11 +197,7 @@ SeamCue ColourSeamAlong(const DepthImage& image, const Eigen::Vector3d& a, const
   double texture = 0.0;
   for (int j = 0; j < m; ++j) {
     if (std::abs(j - line) * 0.5 < o.flank_px + 1.5) continue;
-    double sum = 0.0;
-    for (int i = 0; i < n; ++i) {
-      if (!std::isnan(at(i, j))) sum += at(i, j);
-    }
-    texture = std::max(texture, sum / n);
+    texture = std::max(texture, side_mean(j).value_or(0.0));
   }
   if (showing >= o.min_coverage * n && line_mean >= o.texture_ratio * texture) {
     cue.coverage = static_cast<double>(showing) / n;

@@ -97,7 +97,8 @@ TEST(SensorModelsTest, KinectFramesUnchangedForFixedSeeds) {
 
 TEST(SensorModelsTest, StereoNoiseGrowsWithTheSquareOfDepth) {
   auto floor_sigma = [](double height) {
-    const RenderedScene r = Render(TopDown(SensorKind::kStereo, height, {}), Sensor(SensorKind::kStereo));
+    const RenderedScene r =
+        Render(TopDown(SensorKind::kStereo, height, {}), Sensor(SensorKind::kStereo));
     const Moments m = DepthMoments(r, [](int) { return true; });
     EXPECT_GT(m.count, 0.8 * r.cloud.size()) << height;
     EXPECT_NEAR(m.mean, height, 3e-3) << height;  // no bias
@@ -112,11 +113,13 @@ TEST(SensorModelsTest, StereoNoiseGrowsWithTheSquareOfDepth) {
 
 TEST(SensorModelsTest, StereoDropsDepthOutsideItsWorkingRange) {
   for (double height : {1.0, 2.7}) {
-    const RenderedScene r = Render(TopDown(SensorKind::kStereo, height, {}), Sensor(SensorKind::kStereo));
+    const RenderedScene r =
+        Render(TopDown(SensorKind::kStereo, height, {}), Sensor(SensorKind::kStereo));
     EXPECT_EQ(r.stats.valid, 0) << height;
   }
-  const Scene scene = MakeHeapScene(kCartonS, 10, 4,
-                                    SensorPlacement(SensorKind::kStereo, *SensorIntrinsics(SensorKind::kStereo)));
+  const Scene scene =
+      MakeHeapScene(kCartonS, 10, 4,
+                    SensorPlacement(SensorKind::kStereo, *SensorIntrinsics(SensorKind::kStereo)));
   const RenderedScene r = Render(scene, Sensor(SensorKind::kStereo));
   EXPECT_GT(r.stats.valid, 0.5 * r.cloud.size());
   for (const Eigen::Vector3f& p : r.cloud.xyz) {
@@ -252,8 +255,8 @@ TEST(SensorModelsTest, StereoResolution1280x720) {
 // outline return a depth between the top face and the floor.
 TEST(SensorModelsTest, TimeOfFlightMixedPixelsAppearAtDepthJumps) {
   const double height = 1.3, z_top = height - kCartonS.h;
-  const RenderedScene r = Render(TopDown(SensorKind::kTimeOfFlight, height, {0.0}),
-                                 Sensor(SensorKind::kTimeOfFlight));
+  const RenderedScene r =
+      Render(TopDown(SensorKind::kTimeOfFlight, height, {0.0}), Sensor(SensorKind::kTimeOfFlight));
   const CameraIntrinsics& cam = r.camera;
   EXPECT_EQ(cam.width, 512);
   EXPECT_EQ(cam.height, 424);
@@ -266,7 +269,8 @@ TEST(SensorModelsTest, TimeOfFlightMixedPixelsAppearAtDepthJumps) {
       bool near_outline = false;
       for (int dv = -1; dv <= 1; ++dv) {
         for (int du = -1; du <= 1; ++du) {
-          near_outline |= r.instance[(v + dv) * cam.width + u + du] != r.instance[v * cam.width + u];
+          near_outline |=
+              r.instance[(v + dv) * cam.width + u + du] != r.instance[v * cam.width + u];
         }
       }
       between_far_from_outline += !near_outline;
@@ -313,8 +317,8 @@ TEST(SensorModelsTest, TimeOfFlightMultipathBiasesConcaveCreases) {
 
 TEST(SensorModelsTest, TimeOfFlightNoiseGrowsAsTheReturnWeakens) {
   auto floor_sigma = [](double height) {
-    const RenderedScene r = Render(TopDown(SensorKind::kTimeOfFlight, height, {}),
-                                   Sensor(SensorKind::kTimeOfFlight));
+    const RenderedScene r =
+        Render(TopDown(SensorKind::kTimeOfFlight, height, {}), Sensor(SensorKind::kTimeOfFlight));
     return DepthMoments(r, [](int) { return true; }).stddev;
   };
   // The amplitude falls as 1/z^2, so sigma grows about as z.
@@ -324,9 +328,10 @@ TEST(SensorModelsTest, TimeOfFlightNoiseGrowsAsTheReturnWeakens) {
   EXPECT_GT(far / near, 2.0);
   EXPECT_LT(far / near, 4.5);
   for (double height : {0.4, 4.8}) {
-    EXPECT_EQ(Render(TopDown(SensorKind::kTimeOfFlight, height, {}), Sensor(SensorKind::kTimeOfFlight))
-                  .stats.valid,
-              0)
+    EXPECT_EQ(
+        Render(TopDown(SensorKind::kTimeOfFlight, height, {}), Sensor(SensorKind::kTimeOfFlight))
+            .stats.valid,
+        0)
         << height;
   }
 }
@@ -353,8 +358,8 @@ TEST(SensorModelsTest, SameSeedSameFramesForEverySensor) {
     const CameraPlacement place = SensorPlacement(kind, *SensorIntrinsics(kind));
     Scene scene = MakeDistractorPalletScene(kCartonS, 3, 3, 2, 0.001, 3, 2, 9, place);
     const RenderedScene a = Render(scene, Sensor(kind, true));
-    const RenderedScene b = Render(MakeDistractorPalletScene(kCartonS, 3, 3, 2, 0.001, 3, 2, 9, place),
-                                   Sensor(kind, true));
+    const RenderedScene b = Render(
+        MakeDistractorPalletScene(kCartonS, 3, 3, 2, 0.001, 3, 2, 9, place), Sensor(kind, true));
     EXPECT_EQ(Checksum(a), Checksum(b)) << SensorKindName(kind);
     EXPECT_EQ(a.cloud.rgb, b.cloud.rgb) << SensorKindName(kind);
     scene.noise_seed += 1;
@@ -382,7 +387,8 @@ TEST(SensorModelsTest, DistractorPalletReplacesTopLayerBoxes) {
     EXPECT_LT(b.dims.l, kCartonS.l);
     EXPECT_LT(b.dims.b, kCartonS.b);
     // On the layer below: its bottom at the pallet deck plus one layer.
-    EXPECT_NEAR(b.world_T_box.translation().z() - 0.5 * b.dims.h, kEurPalletHeight + kCartonS.h, 1e-9);
+    EXPECT_NEAR(b.world_T_box.translation().z() - 0.5 * b.dims.h, kEurPalletHeight + kCartonS.h,
+                1e-9);
     for (size_t j = 0; j < mixed.boxes.size(); ++j) {
       if (j == i) continue;
       const SceneBox& o = mixed.boxes[j];

@@ -17,7 +17,7 @@ absl::Status InRange(const char* owner, const char* field, double value, double 
                                                  open_lo ? "(" : "[", lo, ", ", hi, "]"));
 }
 
-#define CHECK_RANGE(...)                                         \
+#define CHECK_RANGE(...) \
   if (absl::Status s = InRange(__VA_ARGS__); !s.ok()) return s
 
 }  // namespace

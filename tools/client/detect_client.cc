@@ -11,7 +11,6 @@
 #include "absl/strings/str_cat.h"
 #include "common/box/box_models.h"
 #include "common/io/cloud_io.h"
-#include "common/wire/box_wire.h"
 #include "common/wire/cloud_wire.h"
 #include "common/wire/detection_wire.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
@@ -112,9 +111,8 @@ absl::Status Detect(const CommandArgs& args) {
     const bool have_cloud = cloud_path.has_value() || response.has_cloud();
     PrintDetection(label, have_cloud ? std::optional<size_t>(cloud.size()) : std::nullopt, *det);
   }
-  const BoxDims box =
-      response.has_box_dims_used() ? wire::BoxDimsFromProto(response.box_dims_used()) : common->box;
-  return WriteDetectionOutputs(common->outputs, cloud, intrinsics, *det, box);
+  return WriteDetectionOutputs(common->outputs, cloud, intrinsics, *det,
+                               BoxUsed(*common, response));
 }
 
 }  // namespace

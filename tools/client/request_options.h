@@ -17,7 +17,7 @@ namespace cornerpose::tools {
 struct ClientRequestOptions {
   std::string server;       // --server host:port
   std::string box_text;     // --box as given: "L,B,H" or a model name
-  BoxDims box;              // its dimensions, m
+  BoxDims box;              // its dimensions, m (none for a model only the server knows)
   int deadline_ms = 10000;  // --deadline_ms, per RPC (for a stream: to its first frame)
   OutputPaths outputs;      // --json, --ply, --png, --edges
 };
@@ -35,6 +35,14 @@ void SetBoxSize(const ClientRequestOptions& options, Request* request) {
   } else {
     request->set_box_model(options.box_text);
   }
+}
+
+// The box a response was detected with: the size the server says it used
+// (DetectResponse.box_dims_used), else the one asked for.
+template <typename Response>
+BoxDims BoxUsed(const ClientRequestOptions& options, const Response& response) {
+  return response.has_box_dims_used() ? wire::BoxDimsFromProto(response.box_dims_used())
+                                      : options.box;
 }
 
 // Prints "cornerpose client COMMAND: CODE: message" for a failure; returns

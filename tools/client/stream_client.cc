@@ -10,7 +10,6 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
-#include "common/wire/box_wire.h"
 #include "common/wire/cloud_wire.h"
 #include "common/wire/detection_wire.h"
 #include "cornerpose/v1/perception_service.grpc.pb.h"
@@ -140,10 +139,9 @@ absl::Status Stream(const CommandArgs& args) {
     paths.ply = FramePath(common->outputs.ply, response, "ply");
     paths.png = FramePath(common->outputs.png, response, "png");
     paths.edges = FramePath(common->outputs.edges, response, "pcd");
-    const BoxDims box = response.has_box_dims_used()
-                            ? wire::BoxDimsFromProto(response.box_dims_used())
-                            : common->box;
-    if (absl::Status s = WriteDetectionOutputs(paths, *cloud, std::nullopt, *det, box); !s.ok()) {
+    if (absl::Status s =
+            WriteDetectionOutputs(paths, *cloud, std::nullopt, *det, BoxUsed(*common, response));
+        !s.ok()) {
       context.TryCancel();
       return s;
     }
