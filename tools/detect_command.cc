@@ -66,6 +66,8 @@ constexpr char kHelp[] =
     "                       out (0.05; 0: off)\n"
     "  --turned_check BOOL  a box with a side not measured is taken out when its face\n"
     "                       turned a quarter at a measured corner is a box too (true)\n"
+    "  --unseen_sides BOOL  a side with nothing seen near it (a shadow) may hide a\n"
+    "                       longer side of the box, as an occluded one does (true)\n"
     "  --layer_plane DEG    boxes side by side on one plane (a layer) take the plane\n"
     "                       fitted through all their faces when within DEG of it (12;\n"
     "                       0: every box keeps its own face's plane)\n"
@@ -100,6 +102,8 @@ constexpr char kHelp[] =
     "  --end_on_flat M      a hypothesis whose first refinement step finds a side\n"
     "                       running on flat and no seam, moving it less than M, ends\n"
     "                       there (declined; 0.003; 0: every step)\n"
+    "  --extra_step M       one refinement step more when the last still turned the\n"
+    "                       face's corners by more than M (0.003; 0: never)\n"
     "  --rim_sides BOOL     a side where the face runs on but ends within 2 cm is free\n"
     "                       there, when it is the face's only side in doubt (true)\n"
     "  --anchored_faces BOOL a planar patch that does not tile (an L of box tops, a\n"
@@ -151,6 +155,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("floor_check", &options.floor_check),
         args.SetDouble("level_check", &options.max_below_neighbours_m),
         args.SetBool("turned_check", &options.turned_check),
+        args.SetBool("unseen_sides", &options.acceptance.check_unseen_sides),
         args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
         args.SetDouble("layer_adopt", &options.layer_plane.adopt_angle_deg),
         args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
@@ -164,6 +169,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
         args.SetDouble("end_on_flat", &options.refinement.end_on_flat_shift_m),
+        args.SetDouble("extra_step", &options.refinement.extra_step_corner_move_m),
         args.SetDouble("seam_turn", &options.refinement.seam_turn_min_length_m),
         args.SetBool("layer_down", &options.neighbours_a_layer_down),
         args.SetInt("past_declined", &options.neighbour_steps_past_declined),
@@ -261,6 +267,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "floor_check",
                                                        "level_check",
                                                        "turned_check",
+                                                       "unseen_sides",
                                                        "layer_plane",
                                                        "layer_adopt",
                                                        "seam_colour",
@@ -276,6 +283,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "anchored_faces",
                                                        "rim_sides",
                                                        "end_on_flat",
+                                                       "extra_step",
                                                        "seam_turn",
                                                        "layer_down",
                                                        "past_declined",

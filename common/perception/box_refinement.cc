@@ -897,6 +897,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.rim_extent_tolerance_m", rim_extent_tolerance_m, 0.0, 0.1),
            CheckRange("refinement.iterations", iterations, 0, 20),
            CheckRange("refinement.end_on_flat_shift_m", end_on_flat_shift_m, 0.0, 0.05),
+           CheckRange("refinement.extra_step_corner_move_m", extra_step_corner_move_m, 0.0, 0.05),
            CheckRange("refinement.seam_turn_min_length_m", seam_turn_min_length_m, 0.0, 10.0),
            CheckRange("refinement.seam_turn_max_deg", seam_turn_max_deg, 0.0, 45.0),
            CheckPositive("refinement.max_shift_m", max_shift_m),
@@ -1149,8 +1150,17 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
   RefinementResult result;
   const Eigen::Isometry3d initial = *camera_T_box;
   Eigen::Isometry3d pose = initial;
-  for (int it = 0; it < std::max(1, options.iterations); ++it) {
+  int iterations = std::max(1, options.iterations);
+  for (int it = 0; it < iterations; ++it) {
+    const Eigen::Isometry3d before = pose;
     if (!RefineStep(depth, dims, grasp_face, options, pose, result)) return result;
+    // Still turning after the last planned iteration: one more
+    // (RefinementOptions::extra_step_corner_move_m).
+    if (it == options.iterations - 1 && it > 0 && options.extra_step_corner_move_m > 0.0) {
+      const FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
+      const double turn = Eigen::AngleAxisd(before.linear().transpose() * pose.linear()).angle();
+      if (std::hypot(f.half_a, f.half_b) * turn > options.extra_step_corner_move_m) ++iterations;
+    }
     if (it == 0 && options.iterations > 1 && EndsOnFlat(result, options, pose, initial)) {
       *camera_T_box = pose;
       result.ok = true;  // read, and declined for the side on flat

@@ -102,6 +102,13 @@ struct RefinementOptions {
   double seam_turn_max_deg = 2.0;
   // Iterations of measure-and-update. Count.
   int iterations = 2;
+  // One iteration more when the last one still turned the face so far that
+  // its corners moved more than this: a hypothesis that started a few
+  // degrees off is still turning, and the ends of its long sides, where a
+  // seam is looked for within seam_search_m, are read that far off (a
+  // carton_l corner 4.8 degrees off ended 2 degrees off after two
+  // iterations, its sides read as running on). 0: never. Metres.
+  double extra_step_corner_move_m = 0.003;
   // A hypothesis whose first iteration finds a side running on flat and no
   // seam on any side, having moved it less than this, ends there: the next
   // iteration would read the same bands, and it is declined for that side

@@ -48,6 +48,13 @@ struct AcceptanceOptions {
   // A face measured between two free sides must match its known size within
   // this. Metres.
   double extent_tolerance_m = 0.025;
+  // A side of the grasp face with nothing seen near it (kUnknown: a shadow's
+  // missing returns) may hide more face, as an occluded side does: the box
+  // is declined when a longer side of the box could stand in there (a
+  // carton lying flat, its top's far end in the shadow of a box standing
+  // over it, read as a carton on its side). False: an unseen side says
+  // nothing.
+  bool check_unseen_sides = true;
   // Largest angle between the grasp face's normal and the line of sight to
   // its centre. Degrees.
   double max_grasp_view_angle_deg = 60.0;

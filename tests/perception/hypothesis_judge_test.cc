@@ -248,5 +248,35 @@ TEST(HypothesisJudgeTest, ANeighbourNotBoxedInIsASteppingStone) {
   EXPECT_EQ(stones[0].steps, 1);
 }
 
+// A side with nothing seen near it (kUnknown: a shadow) may hide more face,
+// as an occluded one does: a square carton read on a 0.25 x 0.20 side face
+// whose 0.20 side is unseen could as well be lying flat, its 0.25 x 0.25
+// top running on into the shadow.
+TEST(RefinementVerdictTest, AnUnseenSideWhereALongerSideCouldStandIsDeclined) {
+  constexpr BoxDims kCartonSq{0.25, 0.25, 0.20};
+  RefinementResult ref;
+  ref.ok = true;
+  // +y face: its a axis is the box's z (0.20), its b axis the box's x (0.25).
+  ref.sides = {SideKind::kUnknown, SideKind::kFree, SideKind::kFree, SideKind::kFree};
+  ref.free_sides = 3;
+  AcceptanceOptions o;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonSq, BoxFace::kPlusY, o),
+            "a hidden side could be a longer side of the box");
+  o.check_unseen_sides = false;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonSq, BoxFace::kPlusY, o), "");
+  // On the 0.25 axis of the top face no longer side could stand in.
+  o.check_unseen_sides = true;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonSq, BoxFace::kPlusZ, o), "");
+  // A carton_s top (0.30 x 0.20) unseen at one end of its 0.20 axis: its
+  // 0.30 axis, free at both ends, pins the reading ...
+  ref.sides = {SideKind::kFree, SideKind::kFree, SideKind::kUnknown, SideKind::kFree};
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusZ, o), "");
+  // ... and a side across it unseen too leaves it pinned by the free ones
+  // (a turned reading needs them the other size apart).
+  ref.sides = {SideKind::kUnknown, SideKind::kFree, SideKind::kUnknown, SideKind::kFree};
+  ref.free_sides = 2;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusZ, o), "");
+}
+
 }  // namespace
 }  // namespace cornerpose::testing

@@ -48,13 +48,18 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
     return kNotBoxedIn;
   }
   // A side hidden under something may hide more face: keep the box only if
-  // no bigger side of the box could stand in for this one there.
+  // no bigger side of the box could stand in for this one there (the
+  // box's third side, or, with a side across it hidden too, the face
+  // turned a quarter). A side with nothing seen near it (a shadow's missing
+  // returns) may hide the box's third side as well.
   for (int s = 0; s < 4; ++s) {
-    if (ref.sides[s] != SideKind::kOccluded) continue;
+    const bool occluded = ref.sides[s] == SideKind::kOccluded;
+    const bool unseen = o.check_unseen_sides && ref.sides[s] == SideKind::kUnknown;
+    if (!occluded && !unseen) continue;
     const int here = s < 2 ? axis_a : axis_b, other = s < 2 ? axis_b : axis_a;
     for (int k = 0; k < 3; ++k) {
       if ((k != here && k != other && dims[k] > dims[here] + o.extent_tolerance_m) ||
-          (k == other && dims[k] > dims[here] + o.extent_tolerance_m &&
+          (occluded && k == other && dims[k] > dims[here] + o.extent_tolerance_m &&
            ref.sides[s < 2 ? 2 : 0] == SideKind::kOccluded)) {
         return "a hidden side could be a longer side of the box";
       }
