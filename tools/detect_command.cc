@@ -66,6 +66,8 @@ constexpr char kHelp[] =
     "                       out (0.05; 0: off)\n"
     "  --turned_check BOOL  a box with a side not measured is taken out when its face\n"
     "                       turned a quarter at a measured corner is a box too (true)\n"
+    "  --turned_proposals BOOL  a hypothesis declined for a side on flat proposes its\n"
+    "                       face turned a quarter at its measured corners (true)\n"
     "  --unseen_sides BOOL  a side with nothing seen near it (a shadow) may hide a\n"
     "                       longer side of the box, as an occluded one does (true)\n"
     "  --layer_plane DEG    boxes side by side on one plane (a layer) take the plane\n"
@@ -156,6 +158,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetDouble("level_check", &options.max_below_neighbours_m),
         args.SetBool("turned_check", &options.turned_check),
         args.SetBool("unseen_sides", &options.acceptance.check_unseen_sides),
+        args.SetBool("turned_proposals", &options.turned_proposals),
         args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
         args.SetDouble("layer_adopt", &options.layer_plane.adopt_angle_deg),
         args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
@@ -268,6 +271,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "level_check",
                                                        "turned_check",
                                                        "unseen_sides",
+                                                       "turned_proposals",
                                                        "layer_plane",
                                                        "layer_adopt",
                                                        "seam_colour",

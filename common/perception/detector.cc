@@ -659,7 +659,7 @@ class BoxAcceptance {
   void AcceptAll() {
     std::vector<internal::Candidate> pending = judge_->Evaluate(options_.num_threads);
     std::vector<internal::HypothesisJudge::SteppingStone> stones = judge_->TakeSteppingStones();
-    while ((!pending.empty() || !stones.empty()) && !cancel_.Stopped()) {
+    while ((!pending.empty() || !stones.empty() || judge_->Queued()) && !cancel_.Stopped()) {
       // The reading whose face ends in more free borders goes first, then
       // the higher score: a free border is measured, a seam or a tiling is
       // inferred (two boxes on end side by side have a lying box's outline,

@@ -119,6 +119,16 @@ struct DetectorOptions {
   // cannot separate (a tape edge taken for a seam makes a carton turned
   // across two). Faces whose sides differ by less than 2 cm are skipped.
   bool turned_check = true;
+  // A hypothesis refined and declined for a side that runs on flat proposes
+  // its face turned a quarter about its normal at each of its corners
+  // between two measured sides (free or a seam): a corner proposes both
+  // readings of its box, and the one turned the wrong way runs on past the
+  // true box's shorter side. Only faces whose sides are both at least
+  // refinement.seam_turn_min_length_m long (a shorter side cannot measure
+  // the face's turn: turned bricks came out 13 degrees off) and differ by
+  // 2 cm or more. A turned reading declined in turn proposes none (its
+  // other corners' readings cost a third more refinements for little).
+  bool turned_proposals = true;
   // How far a real box may be off its nominal size (bulge, sag, crushed
   // corners) and still be the box. Unset keeps each stage's own tolerance
   // (pose.length_tolerance_m 0.025, acceptance.extent_tolerance_m 0.025,

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/perception/pose_error.h"
 #include "tests/support/scene_generator.h"
 
 namespace cornerpose::testing {
@@ -68,6 +69,49 @@ TEST(HypothesisJudgeTest, ADeclinedPoseIsJudgedOnceMoreFromAnotherStart) {
     judge.Propose(Moved(gt, -0.004), 0, {});
     judge.Evaluate(1);
     EXPECT_EQ(judge.stats().refined, retry ? 2 : 1);
+  }
+}
+
+// A corner proposes both readings of its box; the one turned the wrong way
+// runs on flat past the true box's shorter side and is declined. Declined
+// so, it proposes its face turned a quarter at its measured corners
+// (DetectorOptions::turned_proposals): the next round judges the true box.
+TEST(HypothesisJudgeTest, AReadingDeclinedOnFlatProposesItsTurnedReadings) {
+  // Two cartons side by side along their 0.20 m sides, 4 mm apart.
+  Scene scene;
+  scene.world_T_camera = LookAtCamera(Eigen::Vector3d::Zero(), 1.2, 10.0, 20.0, 0.0);
+  for (const double y : {0.0, kCartonS.b + 0.004}) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = Eigen::Vector3d(0.0, y, kCartonS.h / 2.0);
+    scene.boxes.push_back({kCartonS, pose, true});
+  }
+  const RenderedDepth b = RenderNoiseFree(scene);
+  const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;
+  const BoxFace top = b.out.boxes.at(0).grasp_face;
+  ASSERT_EQ(top, BoxFace::kPlusZ);
+  // The wrong reading: the first carton's face turned a quarter at its
+  // outer corner (+x, -y), reaching into the second carton.
+  const Eigen::Isometry3d wrong = internal::TurnedAtCorner(gt, top, kCartonS, 1.0, -1.0);
+  for (const bool turned : {true, false}) {
+    DetectorOptions o;
+    o.box = kCartonS;
+    o.turned_proposals = turned;
+    internal::HypothesisJudge judge(b.depth, o);
+    judge.Propose(wrong, 0, {});
+    EXPECT_TRUE(judge.Evaluate(1).empty());
+    ASSERT_EQ(judge.declined().size(), 1u);
+    EXPECT_EQ(judge.declined()[0].reason.rfind("a side runs on flat", 0), 0u)
+        << judge.declined()[0].reason;
+    EXPECT_EQ(judge.Queued(), turned);
+    const std::vector<internal::Candidate> next = judge.Evaluate(1);
+    if (!turned) {
+      EXPECT_TRUE(next.empty());
+      continue;
+    }
+    ASSERT_EQ(next.size(), 1u);
+    const PoseError e = ComparePoses(next[0].box.camera_T_box, gt, kCartonS);
+    EXPECT_LT(e.translation_m, 0.01);
+    EXPECT_LT(e.rotation_deg, 2.0);
   }
 }
 
@@ -151,6 +195,7 @@ TEST(HypothesisJudgeTest, ANeighbourRunningOnFlatIsASteppingStone) {
     DetectorOptions o;
     o.box = kCartonS;
     o.neighbour_steps_past_declined = steps;
+    o.turned_proposals = false;  // only the hypotheses proposed here
     // A corner's hypothesis: declined, no stepping stone.
     {
       internal::HypothesisJudge judge(depth, o);

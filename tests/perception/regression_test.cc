@@ -481,9 +481,12 @@ TEST(RegressionTest, TheNeighbourChainGoesOnPastABrickWithASeamMissed) {
       options.box = brick;
       if (!past) options.neighbour_steps_past_declined = 0;
       if (!seam_turn) options.refinement.seam_turn_min_length_m = 0.0;
-      // Without both, the refinement of two steps the rules were made for:
-      // a third step for a brick still turning carries this chain on too.
-      if (!past && !seam_turn) options.refinement.extra_step_corner_move_m = 0.0;
+      // Without both, the detector the rules were made for: a third step for
+      // a brick still turning, or its turned readings, carry the chain on too.
+      if (!past && !seam_turn) {
+        options.refinement.extra_step_corner_move_m = 0.0;
+        options.turned_proposals = false;
+      }
       const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
       ASSERT_TRUE(det.ok()) << det.status();
       const std::string what = absl::StrCat("frame ", i, " past ", past, " seam_turn ", seam_turn);
@@ -583,9 +586,12 @@ TEST(RegressionTest, ABoxOfAnotherSizeReadOnEndReachesIntoANoisyFloor) {
     DetectorOptions options;
     options.box = carton_l;
     options.floor_check = check;
-    // Without it, the refinement of two steps the check was made for (a
-    // third step for a face still turning reads this box right as well).
-    if (!check) options.refinement.extra_step_corner_move_m = 0.0;
+    // Without it, the detector the check was made for (a third step for a
+    // face still turning, or the turned readings, read this box right too).
+    if (!check) {
+      options.refinement.extra_step_corner_move_m = 0.0;
+      options.turned_proposals = false;
+    }
     const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
     ASSERT_TRUE(det.ok()) << det.status();
     const int wrong = WrongBoxes(*det, r);
@@ -683,6 +689,9 @@ TEST(RegressionTest, AFaceStillTurningAfterTwoStepsGetsAThird) {
     DetectorOptions options;
     options.box = carton_l;
     options.refinement.extra_step_corner_move_m = corner_move;
+    // The turned readings of the declined hypotheses find these cartons
+    // as well: without them, the step alone.
+    options.turned_proposals = false;
     const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
     if (!det.ok()) {
       ADD_FAILURE() << det.status();

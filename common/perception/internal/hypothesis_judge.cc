@@ -183,8 +183,14 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
     refined[i] = r;
   });
   std::vector<Candidate> out;
+  std::vector<Eigen::Isometry3d> turned;  // DetectorOptions::turned_proposals
   for (int i = 0; i < n; ++i) {
     stats_.refined += refined[i];
+    // Not a turned reading's own: turning it back is where it came from.
+    if (!accepted[i] && refined[i] && reasons[i] == kRunsOnFlat && options_.turned_proposals &&
+        !queue_[i].turned) {
+      TurnedReadings(results[i], &turned);
+    }
     if (!accepted[i]) {
       // A stepping stone: a neighbour (of a box accepted, or within the
       // allowed steps past declined ones) declined for a side on flat, or
@@ -220,7 +226,29 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
     out.push_back(std::move(results[i]));
   }
   queue_.clear();
+  // Judged in the next round, as the neighbours of the boxes accepted here.
+  for (const Eigen::Isometry3d& t : turned) {
+    if (Proposal* p = ProposeBare(t)) p->turned = true;
+  }
   return out;
+}
+
+void HypothesisJudge::TurnedReadings(const Candidate& declined,
+                                     std::vector<Eigen::Isometry3d>* out) const {
+  const BoxFace grasp = declined.box.grasp_face;
+  const int axis_n = static_cast<int>(grasp) / 2;
+  const double A = options_.box[(axis_n + 1) % 3], B = options_.box[(axis_n + 2) % 3];
+  const double min_side = options_.refinement.seam_turn_min_length_m;
+  if (std::abs(A - B) < 0.02 || std::min(A, B) < min_side) return;
+  const std::array<SideKind, 4>& sides = declined.refinement.sides;
+  auto measured = [](SideKind k) { return k == SideKind::kFree || k == SideKind::kSeam; };
+  for (double sa : {1.0, -1.0}) {
+    for (double sb : {1.0, -1.0}) {
+      if (measured(sides[sa > 0 ? 0 : 1]) && measured(sides[sb > 0 ? 2 : 3])) {
+        out->push_back(TurnedAtCorner(declined.box.camera_T_box, grasp, options_.box, sa, sb));
+      }
+    }
+  }
 }
 
 Eigen::Isometry3d TurnedAtCorner(const Eigen::Isometry3d& camera_T_box, BoxFace grasp,

@@ -88,6 +88,9 @@ class HypothesisJudge {
   // (DetectorOptions::neighbour_steps_past_declined).
   std::vector<SteppingStone> TakeSteppingStones() { return std::exchange(stepping_stones_, {}); }
 
+  // Proposals queued and not yet evaluated (the turned readings of the last
+  // round's declined hypotheses: DetectorOptions::turned_proposals).
+  bool Queued() const { return !queue_.empty(); }
   const HypothesisStats& stats() const { return stats_; }
   const std::vector<DeclinedCandidate>& declined() const { return declined_; }
 
@@ -98,6 +101,7 @@ class HypothesisJudge {
     std::vector<int> segments;
     bool from_face;
     bool retry = false;      // a second start at a pose declined once
+    bool turned = false;     // a declined hypothesis's turned reading
     bool neighbour = false;  // proposed by a box accepted
     bool chained = false;    // ... one reached through a stepping stone
     int past_declined = 0;   // proposed by a stepping stone this many declined boxes past
@@ -106,6 +110,10 @@ class HypothesisJudge {
   // Propose() with no corners or segments: the queued proposal, for the
   // caller to mark, or null when it was seen before.
   Proposal* ProposeBare(const Eigen::Isometry3d& camera_T_box);
+  // The face of a hypothesis declined for a side on flat, turned a quarter
+  // at each corner between two measured sides (TurnedAtCorner), appended to
+  // `out` (DetectorOptions::turned_proposals).
+  void TurnedReadings(const Candidate& declined, std::vector<Eigen::Isometry3d>* out) const;
   // Evaluates one proposal; false when rejected. `refined` is set when it
   // got as far as refinement; then `reason` says why it was rejected, and
   // out->box holds the refined pose and out->box.score its first support.
