@@ -1150,16 +1150,19 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
   RefinementResult result;
   const Eigen::Isometry3d initial = *camera_T_box;
   Eigen::Isometry3d pose = initial;
+  // Still turning after the last planned iteration: one more
+  // (RefinementOptions::extra_step_corner_move_m), by how far the turn moved
+  // the face's corners (its half diagonal times the turn).
+  const FaceFrame face = MakeFaceFrame(initial, dims, grasp_face);
+  const double half_diagonal = std::hypot(face.half_a, face.half_b);
   int iterations = std::max(1, options.iterations);
   for (int it = 0; it < iterations; ++it) {
-    const Eigen::Isometry3d before = pose;
+    const Eigen::Matrix3d before = pose.linear();
     if (!RefineStep(depth, dims, grasp_face, options, pose, result)) return result;
-    // Still turning after the last planned iteration: one more
-    // (RefinementOptions::extra_step_corner_move_m).
-    if (it == options.iterations - 1 && it > 0 && options.extra_step_corner_move_m > 0.0) {
-      const FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
-      const double turn = Eigen::AngleAxisd(before.linear().transpose() * pose.linear()).angle();
-      if (std::hypot(f.half_a, f.half_b) * turn > options.extra_step_corner_move_m) ++iterations;
+    if (it == options.iterations - 1 && it > 0 && options.extra_step_corner_move_m > 0.0 &&
+        half_diagonal * Eigen::AngleAxisd(before.transpose() * pose.linear()).angle() >
+            options.extra_step_corner_move_m) {
+      ++iterations;
     }
     if (it == 0 && options.iterations > 1 && EndsOnFlat(result, options, pose, initial)) {
       *camera_T_box = pose;

@@ -298,21 +298,17 @@ bool CheckTurnedReadings(const internal::HypothesisJudge& judge, const DetectorO
     const DetectedBox& box = (*boxes)[i];
     const std::array<SideKind, 4>& s = (*sides)[i];
     if (std::all_of(s.begin(), s.end(), measured)) return "";
-    const int axis_n = static_cast<int>(box.grasp_face) / 2;
-    if (std::abs(options.box[(axis_n + 1) % 3] - options.box[(axis_n + 2) % 3]) < 0.02) return "";
     const Eigen::Isometry3d& T = box.camera_T_box;
     for (const Eigen::Isometry3d& c : *cleared) {
       if ((c.translation() - T.translation()).norm() < 1e-4 && c.linear().isApprox(T.linear())) {
         return "";
       }
     }
-    for (double sa : {1.0, -1.0}) {
-      for (double sb : {1.0, -1.0}) {
-        if (!measured(s[sa > 0 ? 0 : 1]) || !measured(s[sb > 0 ? 2 : 3])) continue;
-        if (judge.JudgeAlone(internal::TurnedAtCorner(T, box.grasp_face, options.box, sa, sb))) {
-          return "its face reads as well turned a quarter at one of its corners (a line in a face "
-                 "taken for a seam?): declined as ambiguous";
-        }
+    for (const Eigen::Isometry3d& turned :
+         internal::TurnedAtMeasuredCorners(T, box.grasp_face, s, options.box)) {
+      if (judge.JudgeAlone(turned)) {
+        return "its face reads as well turned a quarter at one of its corners (a line in a face "
+               "taken for a seam?): declined as ambiguous";
       }
     }
     cleared->push_back(T);

@@ -235,19 +235,13 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
 
 void HypothesisJudge::TurnedReadings(const Candidate& declined,
                                      std::vector<Eigen::Isometry3d>* out) const {
-  const BoxFace grasp = declined.box.grasp_face;
-  const int axis_n = static_cast<int>(grasp) / 2;
-  const double A = options_.box[(axis_n + 1) % 3], B = options_.box[(axis_n + 2) % 3];
-  const double min_side = options_.refinement.seam_turn_min_length_m;
-  if (std::abs(A - B) < 0.02 || std::min(A, B) < min_side) return;
-  const std::array<SideKind, 4>& sides = declined.refinement.sides;
-  auto measured = [](SideKind k) { return k == SideKind::kFree || k == SideKind::kSeam; };
-  for (double sa : {1.0, -1.0}) {
-    for (double sb : {1.0, -1.0}) {
-      if (measured(sides[sa > 0 ? 0 : 1]) && measured(sides[sb > 0 ? 2 : 3])) {
-        out->push_back(TurnedAtCorner(declined.box.camera_T_box, grasp, options_.box, sa, sb));
-      }
-    }
+  const int axis_n = static_cast<int>(declined.box.grasp_face) / 2;
+  const double shorter = std::min(options_.box[(axis_n + 1) % 3], options_.box[(axis_n + 2) % 3]);
+  if (shorter < options_.refinement.seam_turn_min_length_m) return;
+  for (const Eigen::Isometry3d& t :
+       TurnedAtMeasuredCorners(declined.box.camera_T_box, declined.box.grasp_face,
+                               declined.refinement.sides, options_.box)) {
+    out->push_back(t);
   }
 }
 
@@ -263,6 +257,24 @@ Eigen::Isometry3d TurnedAtCorner(const Eigen::Isometry3d& camera_T_box, BoxFace 
   // B along a, A along b, one corner in common.
   turned.translation() += 0.5 * (A - B) * (sa * R.col(axis_a) - sb * R.col(axis_b));
   return turned;
+}
+
+std::vector<Eigen::Isometry3d> TurnedAtMeasuredCorners(const Eigen::Isometry3d& camera_T_box,
+                                                       BoxFace grasp,
+                                                       const std::array<SideKind, 4>& sides,
+                                                       const BoxDims& dims) {
+  std::vector<Eigen::Isometry3d> out;
+  const int axis_n = static_cast<int>(grasp) / 2;
+  if (std::abs(dims[(axis_n + 1) % 3] - dims[(axis_n + 2) % 3]) < 0.02) return out;
+  auto measured = [](SideKind k) { return k == SideKind::kFree || k == SideKind::kSeam; };
+  for (double sa : {1.0, -1.0}) {
+    for (double sb : {1.0, -1.0}) {
+      if (measured(sides[sa > 0 ? 0 : 1]) && measured(sides[sb > 0 ? 2 : 3])) {
+        out.push_back(TurnedAtCorner(camera_T_box, grasp, dims, sa, sb));
+      }
+    }
+  }
+  return out;
 }
 
 std::optional<Candidate> HypothesisJudge::JudgeAlone(const Eigen::Isometry3d& camera_T_box) const {

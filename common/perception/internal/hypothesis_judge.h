@@ -44,6 +44,15 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
 Eigen::Isometry3d TurnedAtCorner(const Eigen::Isometry3d& camera_T_box, BoxFace grasp,
                                  const BoxDims& dims, double sa, double sb);
 
+// The box turned a quarter at each corner of its grasp face between two
+// measured sides (free or a seam; `sides` as RefinementResult::sides), in
+// the order (+a, +b), (+a, -b), (-a, +b), (-a, -b); none for a face whose
+// sides differ by less than 2 cm (turned, it is the same face).
+std::vector<Eigen::Isometry3d> TurnedAtMeasuredCorners(const Eigen::Isometry3d& camera_T_box,
+                                                       BoxFace grasp,
+                                                       const std::array<SideKind, 4>& sides,
+                                                       const BoxDims& dims);
+
 class HypothesisJudge {
  public:
   // A stopped `cancel` (may be null) leaves the rest of a queue unjudged.
