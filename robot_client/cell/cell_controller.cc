@@ -439,15 +439,17 @@ void CellController::RunPick(PreparedPick pick) {
     if (stopping_) return;  // not planned to run: no record
   }
   SetState(CellState::kPicking);
-  // Polled while the program runs: a stop request or a link that went
-  // silent or stale ends the wait at once (the program is then stopped).
+  // Polled while the program runs: a stop request or a link lost (silent or
+  // stale for read_timeout_s) ends the wait at once (the program is then
+  // stopped). A state only a little late does not: the program runs on the
+  // controller, and a busy host is not a fault of the pick.
   auto cancel = [this]() -> std::optional<std::string> {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (stopping_) return "the daemon is stopping";
     }
-    if (std::optional<std::string> bad = link_.Unhealthy()) {
-      return absl::StrCat("controller link not trusted: ", *bad);
+    if (std::optional<std::string> lost = link_.Lost()) {
+      return absl::StrCat("controller link lost: ", *lost);
     }
     return std::nullopt;
   };

@@ -58,6 +58,16 @@ std::optional<std::string> RobotLink::Unhealthy() const {
   return std::nullopt;
 }
 
+std::optional<std::string> RobotLink::Lost() const {
+  if (!dashboard_->connected()) return "dashboard server connection lost";
+  if (!primary_->connected()) {
+    return absl::StrCat("primary interface lost: ", primary_->connection_status().message());
+  }
+  absl::StatusOr<ur::RtdeState> state = rtde_->Latest(absl::Seconds(options_.read_timeout_s));
+  if (!state.ok()) return std::string(state.status().message());
+  return std::nullopt;
+}
+
 absl::Status RobotLink::StopProgramAndConfirm() {
   const absl::Time deadline = absl::Now() + absl::Seconds(options_.stop_confirm_timeout_s);
   const absl::Time stop_sent = absl::Now();
@@ -65,8 +75,7 @@ absl::Status RobotLink::StopProgramAndConfirm() {
   // RTDE check below is what counts.
   absl::Status stop = dashboard_->Stop(absl::Seconds(options_.stop_confirm_timeout_s));
   if (!stop.ok() && !absl::IsFailedPrecondition(stop)) {
-    return absl::Status(stop.code(),
-                        absl::StrCat("dashboard stop failed: ", stop.message()));
+    return absl::Status(stop.code(), absl::StrCat("dashboard stop failed: ", stop.message()));
   }
   // Bit 1 of robot_status_bits: a program runs; runtime_state 1: stopped.
   constexpr uint32_t kProgramRunningBit = 1u << 1;
@@ -83,13 +92,13 @@ absl::Status RobotLink::StopProgramAndConfirm() {
     }
     sequence = state->sequence;
     if (state->received < stop_sent) continue;
-    if (state->runtime_state == kRuntimeStopped && (state->robot_status_bits & kProgramRunningBit) == 0) {
+    if (state->runtime_state == kRuntimeStopped &&
+        (state->robot_status_bits & kProgramRunningBit) == 0) {
       return absl::OkStatus();
     }
     last = absl::StrCat("runtime state ", state->runtime_state, ", program still running");
   }
-  return absl::DeadlineExceededError(
-      absl::StrCat("cannot confirm the program stopped: ", last));
+  return absl::DeadlineExceededError(absl::StrCat("cannot confirm the program stopped: ", last));
 }
 
 std::optional<std::string> RobotLink::SafetyStop() const {

@@ -36,8 +36,15 @@ class RobotLink {
   absl::StatusOr<ur::RtdeState> State() const;
 
   // Why the link cannot be trusted now (a connection down, RTDE stale);
-  // nullopt when it can.
+  // nullopt when it can. The check before planning and sending a program.
   std::optional<std::string> Unhealthy() const;
+
+  // Why the link is lost (a connection down, or RTDE silent or stale for
+  // read_timeout_s); nullopt when it is not. The watchdog while a program
+  // runs: the program runs on the controller, and a state a few packages
+  // late (a busy host) must not make its end unknown; a stream that stays
+  // quiet still stops it within read_timeout_s.
+  std::optional<std::string> Lost() const;
 
   // Why the arm cannot move now: a protective, safeguard or emergency stop,
   // or a safety fault (from the RTDE safety mode); nullopt when the safety

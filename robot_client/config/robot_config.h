@@ -60,7 +60,9 @@ struct RobotConnectionOptions {
   double rtde_frequency_hz = 125.0;
   // Each connection attempt and handshake, seconds; > 0.
   double connect_timeout_s = 5.0;
-  // RTDE state older than this stops the cell, seconds; in (0, 10].
+  // RTDE state older than this is never planned from nor starts a program
+  // (the cell waits for a fresh one), seconds; in (0, 10]. A program already
+  // running is stopped only when the link stays silent for read_timeout_s.
   double rtde_max_age_s = 0.1;
   // A primary / RTDE link silent this long is taken as lost, seconds; in
   // (0, 60].

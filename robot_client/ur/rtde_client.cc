@@ -226,9 +226,9 @@ void RtdeClient::ReadLoop(TcpConnection* connection, RtdeFramer framer, uint8_t 
       if (!bytes.ok()) {
         status = bytes.status();
         if (absl::IsDeadlineExceeded(status)) {
-          status = absl::UnavailableError(
-              absl::StrCat("RTDE silent for ", absl::FormatDuration(options_.read_timeout),
-                           " (link half-open or controller hung)"));
+          status = absl::UnavailableError(absl::StrCat("RTDE silent for ",
+                                                       absl::FormatDuration(options_.read_timeout),
+                                                       " (link half-open or controller hung)"));
         }
         break;
       }
@@ -263,7 +263,9 @@ std::optional<UrcontrolVersion> RtdeClient::controller_version() const {
   return version_;
 }
 
-absl::StatusOr<RtdeState> RtdeClient::Latest() const {
+absl::StatusOr<RtdeState> RtdeClient::Latest() const { return Latest(options_.max_age); }
+
+absl::StatusOr<RtdeState> RtdeClient::Latest(absl::Duration max_age) const {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!connected_) {
     return absl::UnavailableError(
@@ -271,10 +273,10 @@ absl::StatusOr<RtdeState> RtdeClient::Latest() const {
   }
   if (!latest_) return absl::UnavailableError("RTDE: no data package yet");
   const absl::Duration age = absl::Now() - latest_->received;
-  if (age > options_.max_age) {
-    return absl::DeadlineExceededError(
-        absl::StrCat("RTDE data stale: the newest package is ", absl::FormatDuration(age),
-                     " old (limit ", absl::FormatDuration(options_.max_age), ")"));
+  if (age > max_age) {
+    return absl::DeadlineExceededError(absl::StrCat("RTDE data stale: the newest package is ",
+                                                    absl::FormatDuration(age), " old (limit ",
+                                                    absl::FormatDuration(max_age), ")"));
   }
   return *latest_;
 }

@@ -82,6 +82,9 @@ class RtdeClient {
   // The newest state; UNAVAILABLE when not connected, DEADLINE_EXCEEDED
   // (with its age) when it is older than options.max_age.
   absl::StatusOr<RtdeState> Latest() const;
+  // The same with another age limit (the watchdog of a running program
+  // allows more than the planner does).
+  absl::StatusOr<RtdeState> Latest(absl::Duration max_age) const;
   // The first state with sequence > `sequence`; DEADLINE_EXCEEDED, or
   // UNAVAILABLE when the connection is lost.
   absl::StatusOr<RtdeState> WaitForNewer(uint64_t sequence, absl::Duration timeout) const;

@@ -43,12 +43,16 @@ class CellFaultTest : public testing::CellFixture {
 
 TEST_F(CellFaultTest, RtdeStallMidPickStopsTheProgramAndWaitsForTheOperator) {
   options_.max_picks = 1;
+  // The program waits before its done message, so that it still runs when
+  // the stall has lasted read_timeout_s (a pick at the emulator's pace ends
+  // sooner, and a pick that ends is reported by the primary interface).
+  emulator_->SetHangPrograms(true);
   StartCell();
   ASSERT_TRUE(WaitForProgramRunning(absl::Seconds(60)));
   emulator_->SetRtdeStalled(true);
   v1::CellStatus status;
-  // The stale state is noticed while the program runs; the program is
-  // stopped through the dashboard (which still answers).
+  // The stream stays stale while the program runs; the program is stopped
+  // through the dashboard (which still answers).
   ASSERT_TRUE(WaitForState(v1::CELL_STATE_STOPPED, "RTDE", absl::Seconds(20), &status))
       << status.DebugString();
   ASSERT_TRUE(emulator_->WaitFor([](const RobotSnapshot& s) { return !s.program_running; },
@@ -60,6 +64,7 @@ TEST_F(CellFaultTest, RtdeStallMidPickStopsTheProgramAndWaitsForTheOperator) {
 
   // The stream comes back; the pick's end is unknown, so the cell still
   // waits, now for an operator.
+  emulator_->SetHangPrograms(false);
   emulator_->SetRtdeStalled(false);
   ASSERT_TRUE(WaitForState(v1::CELL_STATE_STOPPED, "AcknowledgeFault", absl::Seconds(20), &status))
       << status.DebugString();
@@ -72,7 +77,7 @@ TEST_F(CellFaultTest, RtdeStallMidPickStopsTheProgramAndWaitsForTheOperator) {
 
   EXPECT_EQ(Acknowledge("", false).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   ASSERT_TRUE(Acknowledge("ada", /*unknown_pick_placed=*/false).ok());
-  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString();
+  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString() << PicksText();
   EXPECT_EQ(status.picks_done(), 1u);
   EXPECT_NE(status.last_acknowledgement().find("ada"), std::string::npos);
   picks = ListPicks();
@@ -80,6 +85,23 @@ TEST_F(CellFaultTest, RtdeStallMidPickStopsTheProgramAndWaitsForTheOperator) {
   // The box was not placed: its slot is used again.
   EXPECT_EQ(picks[1].slot(), 0u);
   EXPECT_EQ(picks[1].outcome(), v1::PICK_OUTCOME_COMPLETED);
+}
+
+TEST_F(CellFaultTest, ABriefRtdeHiccupDoesNotCutAPickShort) {
+  options_.max_picks = 1;
+  StartCell();
+  ASSERT_TRUE(WaitForProgramRunning(absl::Seconds(60)));
+  // Packages a few hundred milliseconds late (a busy host): older than
+  // rtde_max_age_s, well within read_timeout_s. The program runs on.
+  emulator_->SetRtdeStalled(true);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  emulator_->SetRtdeStalled(false);
+  v1::CellStatus status;
+  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString() << PicksText();
+  EXPECT_EQ(status.picks_done(), 1u);
+  EXPECT_EQ(status.picks_failed(), 0u);
+  ASSERT_EQ(emulator_->Programs().size(), 1u);
+  EXPECT_EQ(emulator_->Programs()[0].outcome, ProgramOutcome::kCompleted);
 }
 
 TEST_F(CellFaultTest, SilentLinksStopTheCellUntilTheyTalkAgain) {
@@ -101,7 +123,7 @@ TEST_F(CellFaultTest, SilentLinksStopTheCellUntilTheyTalkAgain) {
       << status.DebugString();
   EXPECT_EQ(emulator_->Snapshot().programs_recorded, sent);
   ASSERT_TRUE(Acknowledge("ada", false).ok());
-  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString();
+  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString() << PicksText();
   EXPECT_EQ(status.picks_done(), 1u);
 }
 
@@ -127,7 +149,7 @@ TEST_F(CellFaultTest, ProgramThatNeverEndsIsStoppedAndItsSlotKept) {
   // The operator found the box on its slot: the slot is taken.
   emulator_->SetHangPrograms(false);
   ASSERT_TRUE(Acknowledge("grace", /*unknown_pick_placed=*/true).ok());
-  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString();
+  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString() << PicksText();
   EXPECT_EQ(status.picks_done(), 1u);  // the acknowledged one counts as placed
   EXPECT_EQ(status.next_slot(), 1u);
   EXPECT_EQ(ListPicks().size(), 1u);  // max_picks was reached by it
@@ -150,7 +172,7 @@ TEST_F(CellFaultTest, ProgramStoppedFromOutsideIsUnknownNotCompleted) {
   EXPECT_NE(picks[0].detail().find("done message"), std::string::npos) << picks[0].detail();
   EXPECT_TRUE(NoProgramSentFor(absl::Seconds(1)));
   ASSERT_TRUE(Acknowledge("ada", false).ok());
-  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString();
+  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString() << PicksText();
   EXPECT_EQ(status.picks_done(), 2u);
 }
 
@@ -176,7 +198,7 @@ TEST_F(CellFaultTest, EmergencyStopNeedsAnAcknowledgementBeforePowerOn) {
   v1::AcknowledgeFaultResponse response;
   ASSERT_TRUE(Acknowledge("ada", false, &response).ok());
   EXPECT_NE(response.cleared().find("EMERGENCY"), std::string::npos) << response.cleared();
-  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString();
+  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString() << PicksText();
   EXPECT_EQ(status.picks_done(), 1u);
 }
 
@@ -193,7 +215,7 @@ TEST_F(CellFaultTest, OperatorPowerOffIsNotUndoneByTheDaemon) {
   // Nothing to acknowledge is refused only when nothing waits; here the
   // acknowledgement clears the unknown pick and allows the bring-up.
   ASSERT_TRUE(Acknowledge("ada", false).ok());
-  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString();
+  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString() << PicksText();
   EXPECT_EQ(status.picks_done(), 1u);
   EXPECT_EQ(Acknowledge("ada", false).error_code(), grpc::StatusCode::FAILED_PRECONDITION);
 }
@@ -208,7 +230,7 @@ TEST_F(CellFaultTest, NoBringUpAtStartUnlessConfigured) {
   EXPECT_TRUE(NoProgramSentFor(absl::Seconds(1)));
   EXPECT_EQ(emulator_->Snapshot().robot_mode, ur_emulator::kRobotModePowerOff);
   ASSERT_TRUE(Acknowledge("ada", false).ok());
-  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString();
+  ASSERT_TRUE(WaitFinished(&status)) << status.DebugString() << PicksText();
 }
 
 // Recorded frames are a replay: without allow_replay (and not a dry run)

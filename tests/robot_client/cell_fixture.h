@@ -178,6 +178,14 @@ class CellFixture : public ::testing::Test {
     return {response.picks().begin(), response.picks().end()};
   }
 
+  // Every pick on record, one line each: what a failed wait prints (a pick
+  // that ended otherwise than expected says why in its detail).
+  std::string PicksText() {
+    std::string text = "picks:\n";
+    for (const v1::PickRecord& pick : ListPicks()) text += pick.ShortDebugString() + "\n";
+    return text;
+  }
+
   RobotClientOptions options_;
   // The daemon's limit on one pick program (tests of a hung program lower it).
   absl::Duration program_timeout_ = absl::Seconds(60);
