@@ -111,6 +111,8 @@ constexpr char kHelp[] =
     "  --anchored_faces BOOL a planar patch that does not tile (an L of box tops, a\n"
     "                       layer cut by the border) proposes a face in each of its\n"
     "                       corners (false)\n"
+    "  --seam_split BOOL    ... and faces framed by the seams seen inside it (lines of\n"
+    "                       missing returns or grooves) and its sides in view (true)\n"
     "  --border_faces BOOL  a planar patch at the image border no bigger than a face\n"
     "                       proposes that face (true)\n"
     "  --leaving_view N     a face the image border cuts is returned when free sides or\n"
@@ -170,6 +172,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("border_faces", &options.faces.propose_at_border),
         args.SetInt("leaving_view", &options.acceptance.leaving_view_free_axes),
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
+        args.SetBool("seam_split", &options.faces.seam_split.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
         args.SetDouble("end_on_flat", &options.refinement.end_on_flat_shift_m),
         args.SetDouble("extra_step", &options.refinement.extra_step_corner_move_m),
@@ -285,6 +288,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "border_faces",
                                                        "leaving_view",
                                                        "anchored_faces",
+                                                       "seam_split",
                                                        "rim_sides",
                                                        "end_on_flat",
                                                        "extra_step",

@@ -69,6 +69,7 @@ absl::Status FaceProposalOptions::Validate() const {
   if (absl::Status s = patches.Validate(); !s.ok()) return s;
   if (absl::Status s = seams.Validate(); !s.ok()) return s;
   if (absl::Status s = anchored.Validate(); !s.ok()) return s;
+  if (absl::Status s = seam_split.Validate(); !s.ok()) return s;
   if (!(size_tolerance_m > 0.0 && size_tolerance_m <= 0.1) ||
       !(max_gap_m >= 0.0 && max_gap_m <= 0.05) ||
       !(max_view_angle_deg > 0.0 && max_view_angle_deg < 90.0) || max_tiles < 1 ||
@@ -200,10 +201,13 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
   std::sort(sorted.begin(), sorted.end());
   const double smallest_face = sorted[0] * sorted[1];
   const double cos_view = std::cos(o.max_view_angle_deg * std::numbers::pi / 180.0);
-  auto anchor = [&](const PlanarPatch& patch, const PlaneRectangle& rect, double cell_m) {
+  auto anchor_and_split = [&](size_t id, const PlaneRectangle& rect, double cell_m) {
     const std::vector<Eigen::Isometry3d> faces =
-        AnchoredFaces(patch, rect, cell_m, image.camera, dims, o.anchored);
+        AnchoredFaces(patches.patches[id], rect, cell_m, image.camera, dims, o.anchored);
     out.poses.insert(out.poses.end(), faces.begin(), faces.end());
+    const std::vector<Eigen::Isometry3d> split =
+        SeamSplitFaces(image, patches, static_cast<int>(id), rect, dims, o.seam_split);
+    out.poses.insert(out.poses.end(), split.begin(), split.end());
   };
   for (size_t id = 0; id < patches.patches.size() && !StopRequested(cancel); ++id) {
     const PlanarPatch& patch = patches.patches[id];
@@ -219,11 +223,12 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     // decides whether every side was seen (AcceptanceOptions).
     const double largest_side = sorted[2] + o.size_tolerance_m;
     const bool at_border = patch.touches_border;
-    // One bigger than a face (a layer, a heap's top) still has its corners
-    // inside the view: faces anchored there.
+    // One bigger than a face (a layer, a heap's top) may still have corners
+    // inside the view (faces anchored there) and seams across it (faces
+    // split out along them).
     if (at_border &&
         (!o.propose_at_border || rect.width > largest_side || rect.height > largest_side)) {
-      if (o.propose_at_border) anchor(patch, rect, cell_m);
+      if (o.propose_at_border) anchor_and_split(id, rect, cell_m);
       continue;
     }
     // A patch filling little of its outline is no face or layer (a floor
@@ -293,7 +298,7 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
       // only for an outline about one face in size (a bigger one is a
       // floor, a wall, a layer cut by the image border).
       if (rect.width > largest_side || rect.height > largest_side) {
-        anchor(patch, rect, cell_m);
+        anchor_and_split(id, rect, cell_m);
         continue;
       }
       for (int n = 0; n < 3; ++n) {

@@ -20,6 +20,7 @@
 #include "common/perception/cancel_token.h"
 #include "common/perception/planar_patches.h"
 #include "common/perception/seam_cues.h"
+#include "common/perception/seam_split_faces.h"
 #include "common/perception/types.h"
 
 namespace cornerpose {
@@ -31,6 +32,10 @@ struct FaceProposalOptions {
   // box tops, a layer with a box of another size, a layer cut by the image
   // border); anchored_faces.h.
   AnchoredFaceOptions anchored;
+  // Faces split out of such a patch along the seams seen inside it (lines
+  // of missing returns or grooves, parallel to its outline);
+  // seam_split_faces.h.
+  SeamSplitOptions seam_split;
   // A run of n faces fits an outline side when it is n sizes plus 0 to
   // (n - 1) max_gap_m long, within size_tolerance_m. Metres.
   double size_tolerance_m = 0.02;

@@ -279,6 +279,55 @@ TEST(FaceProposalsTest, ANotchedLayerProposesOnlyTheTilesThatAreThere) {
   EXPECT_EQ(p.poses.size(), 8u);
 }
 
+// A layer three cartons wide whose ends run past the image's top and
+// bottom: no corner of it in view, its outline no whole number of faces.
+// The seams between its cartons show only as lines of missing returns (a
+// structured-light camera at a 1 mm gap): split along them, it proposes
+// each carton between two seams, or a seam and a side of the outline, on
+// both axes; without the lines, or with the split off, nothing.
+TEST(SeamSplitFacesTest, ALayerCutByTheBorderSplitsAlongLinesOfMissingReturns) {
+  LayerFrame f;
+  f.yaw_deg = 8.0;
+  f.width = 0.6;   // three cartons' 0.20 m sides along a
+  f.height = 1.6;  // past the image's top and bottom
+  f.centre = Eigen::Vector2d(0.01, 0.0);
+  f.Render();
+  EXPECT_TRUE(ProposeFromFaces(f.image, kCarton, FaceProposalOptions{}).poses.empty());
+  const CameraIntrinsics& k = f.image.camera;
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const Eigen::Vector3d ray = PixelRay(k, u, v);
+      const Eigen::Vector2d q = f.ToLayer(ray.x() * kTop, ray.y() * kTop);
+      if (std::abs(q.x()) > f.width / 2) continue;  // the floor
+      bool seam = false;
+      for (double a : {-0.1, 0.1}) seam |= std::abs(q.x() - a) < 0.0012;
+      for (double b : {-0.45, -0.15, 0.15, 0.45}) seam |= std::abs(q.y() - b) < 0.0012;
+      if (seam) f.image.z[static_cast<size_t>(v) * k.width + u] = std::nanf("");
+    }
+  }
+  const FaceProposals split = ProposeFromFaces(f.image, kCarton, FaceProposalOptions{});
+  // Every proposal one of the nine cartons framed by seams, its 0.30 m side
+  // along the layer's b axis, and every one of them proposed.
+  const Eigen::Vector3d along_b = f.FromLayer(0.0, 1.0, 0.0) - f.FromLayer(0.0, 0.0, 0.0);
+  std::vector<int> seen(9, 0);
+  for (const Eigen::Isometry3d& pose : split.poses) {
+    const Eigen::Vector2d q = f.ToLayer(pose.translation().x(), pose.translation().y());
+    const int i = static_cast<int>(std::lround(q.x() / 0.2)) + 1;
+    const int j = static_cast<int>(std::lround(q.y() / 0.3)) + 1;
+    ASSERT_TRUE(i >= 0 && i < 3 && j >= 0 && j < 3) << q.transpose();
+    EXPECT_LT((q - Eigen::Vector2d((i - 1) * 0.2, (j - 1) * 0.3)).norm(), 0.01) << q.transpose();
+    EXPECT_GT(std::abs(pose.linear().col(0).dot(along_b)), 0.99);
+    EXPECT_GT(std::abs(pose.linear().col(2).z()), 0.99);
+    ++seen[3 * j + i];
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 0), 0)
+      << seen[0] << seen[1] << seen[2] << " " << seen[3] << seen[4] << seen[5] << " " << seen[6]
+      << seen[7] << seen[8] << " patches " << split.num_patches;
+  FaceProposalOptions off;
+  off.seam_split.enabled = false;
+  EXPECT_TRUE(ProposeFromFaces(f.image, kCarton, off).poses.empty());
+}
+
 TEST(FaceProposalsTest, TwoTilingsOfOneOutlineAreDeclinedWithoutASeamCue) {
   LayerFrame f;
   f.width = 0.6;
@@ -520,6 +569,12 @@ TEST(FaceProposalOptionsTest, ValidateNamesTheField) {
   o = {};
   o.min_eroded_share = 1.5;
   EXPECT_NE(o.Validate().message().find("min_eroded_share=1.5"), std::string::npos);
+  o = {};
+  o.seam_split.min_seam_share = 0;
+  EXPECT_NE(o.Validate().message().find("seam_split.min_seam_share=0"), std::string::npos);
+  o = {};
+  o.seam_split.max_side_m = -2;
+  EXPECT_NE(o.Validate().message().find("seam_split.max_side_m=-2"), std::string::npos);
 }
 
 }  // namespace

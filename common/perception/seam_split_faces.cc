@@ -1,0 +1,222 @@
+#include "common/perception/seam_split_faces.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "common/perception/face_proposals.h"
+
+namespace cornerpose {
+namespace {
+
+// A place a face may end along one axis of the outline: a seam or a side of
+// the outline in view. Metres from the outline's corner; strength for the
+// order in which faces are kept (a side of the outline counts 1).
+struct Stop {
+  double at;
+  double strength;
+};
+
+// Two stops a side of the box apart: the face between them along one axis.
+struct Span {
+  double from, to;
+  int dim;  // box axis the span measures
+  double strength;
+};
+
+}  // namespace
+
+absl::Status SeamSplitOptions::Validate() const {
+  auto outside = [](const char* name, double value, const char* range) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("faces.seam_split.", name, "=", value, " is outside ", range));
+  };
+  if (!(step_m > 0.0 && step_m <= 0.02)) return outside("step_m", step_m, "(0, 0.02]");
+  if (!(min_seam_share > 0.0 && min_seam_share <= 1.0)) {
+    return outside("min_seam_share", min_seam_share, "(0, 1]");
+  }
+  if (!(min_seam_ratio >= 1.0 && min_seam_ratio <= 100.0)) {
+    return outside("min_seam_ratio", min_seam_ratio, "[1, 100]");
+  }
+  if (!(size_tolerance_m > 0.0 && size_tolerance_m <= 0.05)) {
+    return outside("size_tolerance_m", size_tolerance_m, "(0, 0.05]");
+  }
+  if (!(max_side_m > 0.0 && max_side_m <= 100.0)) {
+    return outside("max_side_m", max_side_m, "(0, 100]");
+  }
+  if (max_per_patch < 1 || max_per_patch > 1000) {
+    return outside("max_per_patch", max_per_patch, "[1, 1000]");
+  }
+  return absl::OkStatus();
+}
+
+std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const PlanarPatches& patches,
+                                              int patch_id, const PlaneRectangle& rect,
+                                              const BoxDims& dims, const SeamSplitOptions& o) {
+  std::vector<Eigen::Isometry3d> out;
+  if (!o.enabled || patch_id < 0 || patch_id >= static_cast<int>(patches.patches.size())) {
+    return out;
+  }
+  const PlanarPatch& patch = patches.patches[patch_id];
+  const CameraIntrinsics& k = depth.camera;
+  const double step = o.step_m;
+  if (rect.width > o.max_side_m || rect.height > o.max_side_m) return out;
+  // Narrower than every side of the box: no face fits.
+  const double shortest = std::min({dims.l, dims.b, dims.h}) - o.size_tolerance_m;
+  if (rect.width < shortest || rect.height < shortest) return out;
+  const Eigen::Vector3d corner =
+      rect.centre - 0.5 * rect.width * rect.axis_u - 0.5 * rect.height * rect.axis_v;
+  // Behind the plane by more than its noise: a groove, or what a gap shows.
+  const double behind = std::max(0.005, 3.0 * patch.rms_m);
+  auto pixel_of = [&](const Eigen::Vector3d& p, int* u, int* v) {
+    if (p.z() <= 0.05) return false;
+    const Eigen::Vector2d px = Project(k, p);
+    *u = static_cast<int>(std::lround(px.x()));
+    *v = static_cast<int>(std::lround(px.y()));
+    return depth.inside(*u, *v);
+  };
+  auto on_patch = [&](const Eigen::Vector3d& p) {
+    int u, v;
+    return pixel_of(p, &u, &v) && patches.PatchAt(u, v) == patch_id;
+  };
+  // One cell of the patch's grid on the plane: how far a seam's own cells
+  // (left out of the patch by the segmentation) reach either side of it.
+  const double cell_m = std::max(step, patch.centroid.z() / k.fx * patches.step_px);
+
+  // The share of each line's samples with no return or behind the plane,
+  // lines across `axis` every `step` from the corner; -1 where too few of
+  // its samples lie on the patch. A sample counts where the patch is, or
+  // where it is on both sides of the line (a seam's cells).
+  auto scan = [&](const Eigen::Vector3d& axis, double length, const Eigen::Vector3d& across,
+                  double span) {
+    const int lines = static_cast<int>(length / step);
+    const int samples = static_cast<int>(span / (2.0 * step));
+    std::vector<double> share(std::max(lines, 0), -1.0);
+    for (int i = 0; i < lines; ++i) {
+      const double t = (i + 0.5) * step;
+      int on = 0, holes = 0;
+      for (int j = 0; j < samples; ++j) {
+        const Eigen::Vector3d p = corner + t * axis + (j + 0.5) * 2.0 * step * across;
+        int u, v;
+        if (!pixel_of(p, &u, &v)) continue;
+        if (patches.PatchAt(u, v) != patch_id &&
+            !(on_patch(p - 1.5 * cell_m * axis) && on_patch(p + 1.5 * cell_m * axis))) {
+          continue;
+        }
+        const float z = depth.at(u, v);
+        bool hole = std::isnan(z);
+        if (!hole) {
+          const double off = (static_cast<double>(z) * PixelRay(k, u, v) - p).dot(rect.normal);
+          if (off > behind) continue;  // something in front: no say
+          hole = off < -behind;
+        }
+        ++on;
+        holes += hole;
+      }
+      if (on >= 20) share[i] = static_cast<double>(holes) / on;
+    }
+    return share;
+  };
+  // Stops along one axis: the seams, and each side of the outline whose
+  // ends are in view (a side at the image border is where the view ends).
+  auto stops_along = [&](const Eigen::Vector3d& axis, double length, const Eigen::Vector3d& across,
+                         double span) {
+    std::vector<Stop> stops;
+    const std::vector<double> share = scan(axis, length, across, span);
+    std::vector<double> valid;
+    for (double s : share) {
+      if (s >= 0.0) valid.push_back(s);
+    }
+    if (valid.empty()) return stops;
+    std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
+    const double floor = std::max(valid[valid.size() / 2], 0.01);
+    const double needed = std::max(o.min_seam_share, o.min_seam_ratio * floor);
+    for (size_t i = 0; i < share.size(); ++i) {
+      const double s = share[i];
+      if (s < needed) continue;
+      // The line's best: not lower than the one before, higher than the next.
+      if ((i > 0 && share[i - 1] > s) || (i + 1 < share.size() && share[i + 1] >= s)) continue;
+      stops.push_back({(i + 0.5) * step, s});
+    }
+    constexpr double kBorderPx = 6.0;
+    for (double at : {0.0, length}) {
+      bool seen = true;
+      // Its middle half: a side crossing the view ends where the view does.
+      for (double f : {0.25, 0.5, 0.75}) {
+        const Eigen::Vector3d p = corner + at * axis + f * span * across;
+        if (p.z() <= 0.05) {
+          seen = false;
+          break;
+        }
+        const Eigen::Vector2d px = Project(k, p);
+        seen &= px.x() >= kBorderPx && px.y() >= kBorderPx && px.x() < k.width - kBorderPx &&
+                px.y() < k.height - kBorderPx;
+      }
+      if (seen) stops.push_back({at, 1.0});
+    }
+    std::sort(stops.begin(), stops.end(), [](const Stop& a, const Stop& b) { return a.at < b.at; });
+    return stops;
+  };
+  auto spans_of = [&](const std::vector<Stop>& stops) {
+    std::vector<Span> spans;
+    for (size_t a = 0; a < stops.size(); ++a) {
+      for (size_t b = a + 1; b < stops.size(); ++b) {
+        for (int d = 0; d < 3; ++d) {
+          if (std::abs(stops[b].at - stops[a].at - dims[d]) <= o.size_tolerance_m) {
+            spans.push_back({stops[a].at, stops[b].at, d, stops[a].strength + stops[b].strength});
+          }
+        }
+      }
+    }
+    return spans;
+  };
+  const std::vector<Span> spans_u =
+      spans_of(stops_along(rect.axis_u, rect.width, rect.axis_v, rect.height));
+  if (spans_u.empty()) return out;
+  const std::vector<Span> spans_v =
+      spans_of(stops_along(rect.axis_v, rect.height, rect.axis_u, rect.width));
+
+  struct Face {
+    double strength;
+    Span u, v;
+  };
+  std::vector<Face> faces;
+  for (const Span& su : spans_u) {
+    for (const Span& sv : spans_v) {
+      if (su.dim == sv.dim) continue;
+      const Eigen::Vector3d centre =
+          corner + 0.5 * (su.from + su.to) * rect.axis_u + 0.5 * (sv.from + sv.to) * rect.axis_v;
+      if (!on_patch(centre)) continue;
+      faces.push_back({su.strength + sv.strength, su, sv});
+    }
+  }
+  std::stable_sort(faces.begin(), faces.end(),
+                   [](const Face& a, const Face& b) { return a.strength > b.strength; });
+  std::vector<Face> kept;
+  for (const Face& f : faces) {
+    if (static_cast<int>(kept.size()) >= o.max_per_patch) break;
+    // Equal sides (a square face) frame the same face twice.
+    const bool same = std::any_of(kept.begin(), kept.end(), [&](const Face& g) {
+      return std::abs(g.u.from - f.u.from) < 0.01 && std::abs(g.u.to - f.u.to) < 0.01 &&
+             std::abs(g.v.from - f.v.from) < 0.01 && std::abs(g.v.to - f.v.to) < 0.01 &&
+             std::abs(dims[g.u.dim] - dims[f.u.dim]) < 1e-4 &&
+             std::abs(dims[g.v.dim] - dims[f.v.dim]) < 1e-4;
+    });
+    if (!same) kept.push_back(f);
+  }
+  for (const Face& f : kept) {
+    PlaneRectangle tile = rect;
+    tile.centre =
+        corner + 0.5 * (f.u.from + f.u.to) * rect.axis_u + 0.5 * (f.v.from + f.v.to) * rect.axis_v;
+    tile.width = dims[f.u.dim];
+    tile.height = dims[f.v.dim];
+    const int n = 3 - f.u.dim - f.v.dim;
+    const std::vector<Eigen::Isometry3d> pose =
+        TilePoses(tile, FaceTiling{n, f.u.dim, f.v.dim, 1, 1}, dims);
+    out.insert(out.end(), pose.begin(), pose.end());
+  }
+  return out;
+}
+
+}  // namespace cornerpose
