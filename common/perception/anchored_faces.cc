@@ -169,13 +169,8 @@ std::vector<Eigen::Isometry3d> AnchoredFaces(const PlanarPatch& patch, const Pla
   }
   for (const Anchored& k : kept) {
     const Shape& s = shapes[k.shape];
-    PlaneRectangle tile = rect;
-    tile.centre = origin + k.cu * rect.axis_u + k.cv * rect.axis_v;
-    tile.width = dims[s.su];
-    tile.height = dims[s.sv];
-    const std::vector<Eigen::Isometry3d> pose =
-        TilePoses(tile, FaceTiling{s.n, s.su, s.sv, 1, 1}, dims);
-    out.insert(out.end(), pose.begin(), pose.end());
+    out.push_back(FacePoseAt(rect, origin + k.cu * rect.axis_u + k.cv * rect.axis_v,
+                             FaceTiling{s.n, s.su, s.sv, 1, 1}, dims));
   }
   return out;
 }

@@ -165,6 +165,13 @@ std::vector<Eigen::Isometry3d> TilePoses(const PlaneRectangle& rect, const FaceT
   return out;
 }
 
+Eigen::Isometry3d FacePoseAt(const PlaneRectangle& rect, const Eigen::Vector3d& centre,
+                             const FaceTiling& tiling, const BoxDims& dims) {
+  PlaneRectangle face = rect;
+  face.centre = centre;
+  return TilePose(face, tiling, dims, 0.0, 0.0);
+}
+
 double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const FaceTiling& t,
                    const BoxDims& dims, const SeamCueOptions& options) {
   (void)dims;

@@ -103,6 +103,12 @@ PlaneRectangle OutlineRectangle(const PlanarPatch& patch);
 std::vector<Eigen::Isometry3d> TilePoses(const PlaneRectangle& rect, const FaceTiling& tiling,
                                          const BoxDims& dims);
 
+// The pose of one face of the box (tiling's face, its sides along rect's
+// axes; counts ignored) centred at `centre` on rect's plane: the box behind
+// it, as TilePoses gives a tile.
+Eigen::Isometry3d FacePoseAt(const PlaneRectangle& rect, const Eigen::Vector3d& centre,
+                             const FaceTiling& tiling, const BoxDims& dims);
+
 // Share of the inner tile sides of `tiling` over `rect` that show a colour
 // seam (0 without colour or inner sides).
 double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const FaceTiling& tiling,

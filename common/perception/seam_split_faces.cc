@@ -206,15 +206,10 @@ std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const Pla
     if (!same) kept.push_back(f);
   }
   for (const Face& f : kept) {
-    PlaneRectangle tile = rect;
-    tile.centre =
+    const Eigen::Vector3d centre =
         corner + 0.5 * (f.u.from + f.u.to) * rect.axis_u + 0.5 * (f.v.from + f.v.to) * rect.axis_v;
-    tile.width = dims[f.u.dim];
-    tile.height = dims[f.v.dim];
     const int n = 3 - f.u.dim - f.v.dim;
-    const std::vector<Eigen::Isometry3d> pose =
-        TilePoses(tile, FaceTiling{n, f.u.dim, f.v.dim, 1, 1}, dims);
-    out.insert(out.end(), pose.begin(), pose.end());
+    out.push_back(FacePoseAt(rect, centre, FaceTiling{n, f.u.dim, f.v.dim, 1, 1}, dims));
   }
   return out;
 }

@@ -49,21 +49,19 @@ void RobotLink::Close() {
 absl::StatusOr<ur::RtdeState> RobotLink::State() const { return rtde_->Latest(); }
 
 std::optional<std::string> RobotLink::Unhealthy() const {
-  if (!dashboard_->connected()) return "dashboard server connection lost";
-  if (!primary_->connected()) {
-    return absl::StrCat("primary interface lost: ", primary_->connection_status().message());
-  }
-  absl::StatusOr<ur::RtdeState> state = rtde_->Latest();
-  if (!state.ok()) return std::string(state.status().message());
-  return std::nullopt;
+  return Problem(absl::Seconds(options_.rtde_max_age_s));
 }
 
 std::optional<std::string> RobotLink::Lost() const {
+  return Problem(absl::Seconds(options_.read_timeout_s));
+}
+
+std::optional<std::string> RobotLink::Problem(absl::Duration max_rtde_age) const {
   if (!dashboard_->connected()) return "dashboard server connection lost";
   if (!primary_->connected()) {
     return absl::StrCat("primary interface lost: ", primary_->connection_status().message());
   }
-  absl::StatusOr<ur::RtdeState> state = rtde_->Latest(absl::Seconds(options_.read_timeout_s));
+  absl::StatusOr<ur::RtdeState> state = rtde_->Latest(max_rtde_age);
   if (!state.ok()) return std::string(state.status().message());
   return std::nullopt;
 }

@@ -73,6 +73,9 @@ class RobotLink {
   absl::Status StopProgramAndConfirm();
 
  private:
+  // A connection down, or no RTDE state newer than `max_rtde_age`.
+  std::optional<std::string> Problem(absl::Duration max_rtde_age) const;
+
   const RobotConnectionOptions options_;
   std::unique_ptr<ur::DashboardClient> dashboard_;
   std::unique_ptr<ur::PrimaryClient> primary_;
