@@ -389,6 +389,7 @@ absl::Status AcceptanceOptions::Validate() const {
            CheckRange("acceptance.border_margin_px", border_margin_px, 0.0, 1000.0),
            CheckRange("acceptance.leaving_view_free_axes", leaving_view_free_axes, 0, 2),
            CheckRange("acceptance.overlap_margin_m", overlap_margin_m, 0.0, 1.0),
+           CheckRange("acceptance.settled_overlap_margin_m", settled_overlap_margin_m, 0.0, 1.0),
        }) {
     if (!s.ok()) return s;
   }
@@ -653,7 +654,7 @@ class BoxAcceptance {
   // Judges what is queued, accepts, and judges what the accepted propose,
   // until nothing is left (or the token stops).
   void AcceptAll() {
-    std::vector<internal::Candidate> pending = judge_->Evaluate(options_.num_threads);
+    std::vector<internal::Candidate> pending = judge_->Evaluate(options_.num_threads, det_->boxes);
     std::vector<internal::HypothesisJudge::SteppingStone> stones = judge_->TakeSteppingStones();
     while ((!pending.empty() || !stones.empty() || judge_->Queued()) && !cancel_.Stopped()) {
       // The reading whose face ends in more free borders goes first, then
@@ -687,7 +688,7 @@ class BoxAcceptance {
           if (!OverlapsKept(pose)) judge_->ProposePastDeclined(pose, stone.steps);
         }
       }
-      pending = judge_->Evaluate(options_.num_threads);
+      pending = judge_->Evaluate(options_.num_threads, det_->boxes);
       stones = judge_->TakeSteppingStones();
     }
   }

@@ -72,6 +72,16 @@ struct AcceptanceOptions {
   // Two accepted boxes may not overlap by more than this (each is shrunk by
   // it before the overlap test). Metres.
   double overlap_margin_m = 0.015;
+  // A hypothesis whose box, shrunk by this on every side, overlaps a box
+  // already kept is not judged while that box is kept: refinement moves a
+  // pose by at most RefinementOptions::max_shift_m (5 cm) and turns it by
+  // at most max_turn_deg, so at 5 cm it would still overlap the kept box by
+  // more than overlap_margin_m afterwards and be dropped. On pallets that is
+  // a quarter of all refinements (neighbours of neighbours, second starts,
+  // turned readings, each on a box found). It may be proposed again later
+  // (a box a check takes out frees its place). 0: every hypothesis is
+  // judged. Metres.
+  double settled_overlap_margin_m = 0.05;
 
   absl::Status Validate() const;
 };

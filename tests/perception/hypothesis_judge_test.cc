@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/perception/internal/box_overlap.h"
 #include "common/perception/pose_error.h"
 #include "tests/support/scene_generator.h"
 
@@ -127,6 +128,48 @@ TEST(HypothesisJudgeTest, AnAcceptedPoseIsNotJudgedAgain) {
   EXPECT_TRUE(judge.Evaluate(1).empty());
   EXPECT_EQ(judge.stats().proposed, 1);
   EXPECT_EQ(judge.stats().refined, 1);
+}
+
+// A hypothesis that overlaps a kept box by more than refinement can move it
+// (AcceptanceOptions::settled_overlap_margin_m, 5 cm on every side) is not
+// judged while the box is kept, and is judged when proposed again once the
+// box is gone; one that overlaps it less (7 cm along the 0.30 m side:
+// refinement could move it off) is judged; with the margin 0, every one is.
+TEST(HypothesisJudgeTest, AHypothesisDeepInsideAKeptBoxIsNotJudged) {
+  const RenderedDepth b = RenderOneBox();
+  const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;
+  DetectedBox kept;
+  kept.camera_T_box = gt;
+  for (const double margin : {0.05, 0.0}) {
+    DetectorOptions o;
+    o.box = kCartonS;
+    o.acceptance.settled_overlap_margin_m = margin;
+    internal::HypothesisJudge judge(b.depth, o);
+    // 2 cm off the kept box: deep inside it.
+    judge.Propose(Moved(gt, 0.02), 0, {});
+    const std::vector<internal::Candidate> deep = judge.Evaluate(1, {kept});
+    EXPECT_EQ(judge.stats().refined, margin > 0.0 ? 0 : 1) << margin;
+    EXPECT_EQ(judge.stats().proposed, margin > 0.0 ? 0 : 1) << margin;
+    EXPECT_EQ(deep.size(), margin > 0.0 ? 0u : 1u) << margin;
+    // Its box gone, the same hypothesis is judged (and is the box).
+    judge.Propose(Moved(gt, 0.02), 0, {});
+    const std::vector<internal::Candidate> freed = judge.Evaluate(1, {});
+    if (margin > 0.0) {
+      ASSERT_EQ(freed.size(), 1u);
+      EXPECT_LT(ComparePoses(freed[0].box.camera_T_box, gt, kCartonS).translation_m, 0.005);
+    }
+    EXPECT_EQ(judge.stats().refined, 1) << margin;
+  }
+  // Shifted by 0.23 m along the box's 0.30 m side (x): it overlaps the kept
+  // box by 7 cm, less than twice the margin, so it is judged.
+  DetectorOptions o;
+  o.box = kCartonS;
+  const Eigen::Isometry3d along = gt * Eigen::Translation3d(0.23, 0.0, 0.0);
+  ASSERT_TRUE(internal::BoxesOverlap(gt, along, kCartonS, o.acceptance.overlap_margin_m));
+  internal::HypothesisJudge judge(b.depth, o);
+  judge.Propose(along, 0, {});
+  judge.Evaluate(1, {kept});
+  EXPECT_EQ(judge.stats().proposed, 1);
 }
 
 // A pose whose grasp face runs out of the image but whose face centre and

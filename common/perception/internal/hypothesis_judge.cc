@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "absl/strings/str_format.h"
+#include "common/perception/internal/box_overlap.h"
 #include "common/perception/internal/parallel.h"
 #include "common/perception/pose_error.h"
 
@@ -169,15 +170,23 @@ void HypothesisJudge::ProposePastDeclined(const Eigen::Isometry3d& camera_T_box,
   if (Proposal* p = ProposeBare(camera_T_box)) p->past_declined = steps;
 }
 
-std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
+std::vector<Candidate> HypothesisJudge::Evaluate(int threads,
+                                                 const std::vector<DetectedBox>& kept) {
   const int n = static_cast<int>(queue_.size());
   std::vector<Candidate> results(n);
-  std::vector<char> accepted(n, 0), refined(n, 0);
+  std::vector<char> accepted(n, 0), refined(n, 0), settled(n, 0);
   std::vector<std::string> reasons(n);
+  if (const double m = options_.acceptance.settled_overlap_margin_m; m > 0.0) {
+    for (int i = 0; i < n; ++i) {
+      settled[i] = std::any_of(kept.begin(), kept.end(), [&](const DetectedBox& k) {
+        return BoxesOverlap(k.camera_T_box, queue_[i].camera_T_box, options_.box, m);
+      });
+    }
+  }
   // Work is uneven (most hypotheses fail the first check), so threads take
   // the next hypothesis when done with one.
   ParallelForChunks(n, 1, threads, [&](int, int i, int) {
-    if (StopRequested(cancel_)) return;
+    if (StopRequested(cancel_) || settled[i]) return;
     bool r = false;
     accepted[i] = EvaluateOne(queue_[i], &results[i], &r, &reasons[i]);
     refined[i] = r;
@@ -185,6 +194,15 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads) {
   std::vector<Candidate> out;
   std::vector<Eigen::Isometry3d> turned;  // DetectorOptions::turned_proposals
   for (int i = 0; i < n; ++i) {
+    if (settled[i]) {
+      // Not judged: as if never proposed (a second start kept for later).
+      --stats_.proposed;
+      if (const int s = FindLike(seen_, queue_[i].camera_T_box); s >= 0) {
+        seen_.erase(seen_.begin() + s);
+      }
+      if (queue_[i].retry) second_chance_.push_back(queue_[i].camera_T_box);
+      continue;
+    }
     stats_.refined += refined[i];
     // Not a turned reading's own: turning it back is where it came from.
     if (!accepted[i] && refined[i] && reasons[i] == kRunsOnFlat && options_.turned_proposals &&

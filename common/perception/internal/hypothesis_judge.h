@@ -80,8 +80,10 @@ class HypothesisJudge {
   // Evaluates the queue on up to `threads` threads; returns the accepted
   // candidates in the order they were proposed, and empties the queue.
   // Hypotheses that got as far as refinement and failed are kept, with the
-  // reason, in declined().
-  std::vector<Candidate> Evaluate(int threads);
+  // reason, in declined(). Those that overlap a box of `kept` too deeply
+  // for refinement to free them (AcceptanceOptions::
+  // settled_overlap_margin_m) are not judged, and may be proposed again.
+  std::vector<Candidate> Evaluate(int threads, const std::vector<DetectedBox>& kept = {});
   // Judges one pose now, outside the queue: no duplicate is dropped and
   // nothing is recorded. The accepted candidate, or nothing.
   std::optional<Candidate> JudgeAlone(const Eigen::Isometry3d& camera_T_box) const;
