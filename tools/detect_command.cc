@@ -104,6 +104,9 @@ constexpr char kHelp[] =
     "  --end_on_flat M      a hypothesis whose first refinement step finds a side\n"
     "                       running on flat and no seam, moving it less than M, ends\n"
     "                       there (declined; 0.003; 0: every step)\n"
+    "  --slat_gap M         a face free on two opposite sides, its plane going on\n"
+    "                       past a gap of 1.5 cm to M beyond each (a pallet's deck\n"
+    "                       board, a slat), is declined (0.06; 0: off)\n"
     "  --extra_step M       one refinement step more when the last still turned the\n"
     "                       face's corners by more than M (0.003; 0: never)\n"
     "  --rim_sides BOOL     a side where the face runs on but ends within 2 cm is free\n"
@@ -175,6 +178,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("seam_split", &options.faces.seam_split.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
         args.SetDouble("end_on_flat", &options.refinement.end_on_flat_shift_m),
+        args.SetDouble("slat_gap", &options.refinement.slat_gap_max_m),
         args.SetDouble("extra_step", &options.refinement.extra_step_corner_move_m),
         args.SetDouble("seam_turn", &options.refinement.seam_turn_min_length_m),
         args.SetBool("layer_down", &options.neighbours_a_layer_down),
@@ -291,6 +295,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "seam_split",
                                                        "rim_sides",
                                                        "end_on_flat",
+                                                       "slat_gap",
                                                        "extra_step",
                                                        "seam_turn",
                                                        "layer_down",

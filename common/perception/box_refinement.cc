@@ -815,6 +815,55 @@ bool ShadowedByOccluder(const DepthImage& depth, const Eigen::Vector3d& side_cen
   return in_front >= 2;
 }
 
+// Where, past a free side, the face's plane goes on after a gap of
+// slat_gap_min_m to slat_gap_max_m on two of three lines across the side
+// (off the plane, or no return, from the side's blur on, then two samples
+// on the plane again within the gap's range): the point on the plane where
+// it goes on (the middle-most such line's). Something standing in front of
+// the plane on a line ends that line (not one flat surface).
+std::optional<Eigen::Vector3d> PlaneGoesOnPastGap(const DepthImage& depth,
+                                                  const Eigen::Vector3d& side_centre,
+                                                  const Eigen::Vector3d& across,
+                                                  const Eigen::Vector3d& along, double half_along,
+                                                  const RefinementOptions& o,
+                                                  const Eigen::Vector3d& normal) {
+  constexpr double kStep = 0.003, kBlur = 0.012;
+  int lines = 0;
+  std::optional<Eigen::Vector3d> resumes;
+  for (double t : {0.0, -0.6, 0.6}) {
+    const Eigen::Vector3d start = side_centre + t * half_along * along;
+    int off = 0, on = 0;
+    for (double d = 0.004; d <= o.slat_gap_max_m + kStep; d += kStep) {
+      const Eigen::Vector3d q = start + d * across;
+      if (q.z() <= 0.05) break;
+      const Eigen::Vector2d px = Project(depth.camera, q);
+      const int u = static_cast<int>(std::lround(px.x())),
+                v = static_cast<int>(std::lround(px.y()));
+      if (!depth.inside(u, v)) break;
+      const float z = depth.at(u, v);
+      double height = std::numeric_limits<double>::infinity();  // no return: off the plane
+      if (!std::isnan(z)) height = (z * PixelRay(depth.camera, u, v) - q).dot(normal);
+      if (std::isfinite(height) && height > o.plane_tolerance_m) break;  // something in front
+      if (std::abs(height) > o.plane_tolerance_m) {
+        ++off;
+        on = 0;
+        continue;
+      }
+      if (off < 2) {
+        if (d > kBlur) break;  // the plane goes on with no gap: not a free side's
+        continue;              // within the side's blur
+      }
+      if (++on == 2 && d - kStep >= o.slat_gap_min_m) {
+        ++lines;
+        if (!resumes) resumes = start + (d - kStep) * across;
+        break;
+      }
+    }
+  }
+  if (lines < 2) return std::nullopt;
+  return resumes;
+}
+
 // Where the face's plane ends beyond one side: marches outward from the
 // side along `dir` on the plane, reading the depth image, until the measured
 // surface leaves the plane for good. Returns the distance from the side to
@@ -900,6 +949,8 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.extra_step_corner_move_m", extra_step_corner_move_m, 0.0, 0.05),
            CheckRange("refinement.seam_turn_min_length_m", seam_turn_min_length_m, 0.0, 10.0),
            CheckRange("refinement.seam_turn_max_deg", seam_turn_max_deg, 0.0, 45.0),
+           CheckRange("refinement.slat_gap_min_m", slat_gap_min_m, 0.0, 0.5),
+           CheckRange("refinement.slat_gap_max_m", slat_gap_max_m, 0.0, 0.5),
            CheckPositive("refinement.max_shift_m", max_shift_m),
            CheckPositive("refinement.max_turn_deg", max_turn_deg),
        }) {
@@ -1025,6 +1076,28 @@ void MarkShadowedSides(const DepthImage& depth, const BoxDims& dims, BoxFace gra
                            half_along[i], options, f.n)) {
       result.sides[i] = SideKind::kOccluded;
       --result.free_sides;
+    }
+  }
+}
+
+// RefinementResult::past_gap: where the face's plane goes on past a gap
+// beyond each free side (PlaneGoesOnPastGap), on faces with two opposite
+// free sides.
+void MarkGapsPastFreeSides(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face,
+                           const RefinementOptions& options, const Eigen::Isometry3d& pose,
+                           RefinementResult& result) {
+  if (options.slat_gap_max_m <= 0.0) return;
+  const FaceFrame f = MakeFaceFrame(pose, dims, grasp_face);
+  const Eigen::Vector3d across[4] = {f.a, -f.a, f.b, -f.b};
+  const Eigen::Vector3d along[4] = {f.b, f.b, f.a, f.a};
+  const double half_across[4] = {f.half_a, f.half_a, f.half_b, f.half_b};
+  const double half_along[4] = {f.half_b, f.half_b, f.half_a, f.half_a};
+  for (int pair = 0; pair < 4; pair += 2) {
+    if (result.sides[pair] != SideKind::kFree || result.sides[pair + 1] != SideKind::kFree)
+      continue;
+    for (int i = pair; i < pair + 2; ++i) {
+      result.past_gap[i] = PlaneGoesOnPastGap(depth, f.c + half_across[i] * across[i], across[i],
+                                              along[i], half_along[i], options, f.n);
     }
   }
 }
@@ -1178,6 +1251,7 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
   if (shift > options.max_shift_m || turn_deg > options.max_turn_deg) return result;
   MarkShadowedSides(depth, dims, grasp_face, options, pose, result);
   TileContinuingSides(depth, dims, grasp_face, options, pose, result);
+  MarkGapsPastFreeSides(depth, dims, grasp_face, options, pose, result);
   *camera_T_box = pose;
   result.ok = true;
   return result;

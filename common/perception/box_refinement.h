@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 
 #include "absl/status/status.h"
 #include "common/perception/camera_model.h"
@@ -115,6 +116,14 @@ struct RefinementOptions {
   // (RefineOnGraspFace then returns ok with the first iteration's sides and
   // pose). 0 runs every iteration. Metres.
   double end_on_flat_shift_m = 0.003;
+  // On a face with two opposite free sides, where the face's plane goes on
+  // past a gap of slat_gap_min_m to slat_gap_max_m beyond each (on two of
+  // three lines across the side): RefinementResult::past_gap. A face so
+  // between two gaps in one flat surface, with no box found beyond either,
+  // is a board of a pallet's deck or a slat, not a box (DetectorOptions::
+  // gaps_check). slat_gap_max_m 0 turns it off. Metres.
+  double slat_gap_min_m = 0.015;
+  double slat_gap_max_m = 0.06;
   // Largest correction accepted, beyond which the hypothesis is not this
   // box: metres and degrees.
   double max_shift_m = 0.05;
@@ -143,6 +152,10 @@ struct RefinementResult {
   // or 0 where a side is not free. Metres.
   double extent_a_m = 0.0;
   double extent_b_m = 0.0;
+  // Per side (+a, -a, +b, -b), on faces with two opposite free sides: the
+  // point (camera frame) where the face's plane goes on past a gap beyond
+  // the side (RefinementOptions::slat_gap_min_m), if it does.
+  std::array<std::optional<Eigen::Vector3d>, 4> past_gap;
 };
 
 // Refines camera_T_box in place using the face `grasp_face`.

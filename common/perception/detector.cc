@@ -61,9 +61,16 @@ void ApplySizeTolerance(double t, DetectorOptions* o) {
   o->acceptance.extent_tolerance_m = t + 0.01;
 }
 
-// Takes out the boxes (and their side kinds) for which `why(i)` gives a
+// What the refinement measured of a kept box's grasp face, for the checks
+// after acceptance.
+struct KeptReading {
+  std::array<SideKind, 4> sides;
+  std::array<std::optional<Eigen::Vector3d>, 4> past_gap;  // RefinementResult::past_gap
+};
+
+// Takes out the boxes (and their readings) for which `why(i)` gives a
 // reason, declining each with it. True when one was taken out.
-bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<std::array<SideKind, 4>>* sides,
+bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<KeptReading>* sides,
              std::vector<DeclinedCandidate>* declined,
              const std::function<std::string(size_t)>& why) {
   size_t kept = 0;
@@ -168,7 +175,7 @@ std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptio
 // box of another size read as this one on end). True when a box was taken
 // out.
 bool CheckFloor(const FloorPlane& floor, const DetectorOptions& options,
-                std::vector<DetectedBox>* boxes, std::vector<std::array<SideKind, 4>>* sides,
+                std::vector<DetectedBox>* boxes, std::vector<KeptReading>* sides,
                 std::vector<DeclinedCandidate>* declined) {
   const BoxDims& d = options.box;
   return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
@@ -196,8 +203,7 @@ bool CheckFloor(const FloorPlane& floor, const DetectorOptions& options,
 // a heap, a box on end stands as level with it. True when a box was taken
 // out.
 bool CheckStandsLevel(const DetectorOptions& options, std::vector<DetectedBox>* boxes,
-                      std::vector<std::array<SideKind, 4>>* sides,
-                      std::vector<DeclinedCandidate>* declined) {
+                      std::vector<KeptReading>* sides, std::vector<DeclinedCandidate>* declined) {
   constexpr int kLayerNeighbours = 2;
   const BoxDims& d = options.box;
   const double tol = options.max_below_neighbours_m;
@@ -253,8 +259,7 @@ bool CheckStandsLevel(const DetectorOptions& options, std::vector<DetectedBox>* 
 // nothing. True when a box was taken out.
 bool CheckLayers(const DepthImage& depth, const DetectorOptions& options,
                  const FaceProposals& faces, std::vector<DetectedBox>* boxes,
-                 std::vector<std::array<SideKind, 4>>* sides,
-                 std::vector<DeclinedCandidate>* declined) {
+                 std::vector<KeptReading>* sides, std::vector<DeclinedCandidate>* declined) {
   const size_t n = boxes->size();
   std::vector<int> layer(n, -1);
   std::vector<bool> trusted(faces.layers.size(), false);
@@ -265,13 +270,13 @@ bool CheckLayers(const DepthImage& depth, const DetectorOptions& options,
         LayerUnder(faces, depth, b.grasp_centre_camera, b.grasp_normal_camera, options.faces);
     if (layer[i] < 0) continue;
     tile[i] = IsLayerTile(faces.layers[layer[i]], options.box, b.camera_T_box, options.faces);
-    const std::array<SideKind, 4>& s = (*sides)[i];
+    const std::array<SideKind, 4>& s = (*sides)[i].sides;
     const bool free_a = s[0] == SideKind::kFree || s[1] == SideKind::kFree;
     const bool free_b = s[2] == SideKind::kFree || s[3] == SideKind::kFree;
     if (tile[i] && free_a && free_b) trusted[layer[i]] = true;
   }
   return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
-    const std::array<SideKind, 4>& s = (*sides)[i];
+    const std::array<SideKind, 4>& s = (*sides)[i].sides;
     const bool bounded_by_seams = std::any_of(s.begin(), s.end(), [](SideKind k) {
       return k == SideKind::kSeam || k == SideKind::kTiled || k == SideKind::kContinues;
     });
@@ -284,19 +289,48 @@ bool CheckLayers(const DepthImage& depth, const DetectorOptions& options,
   });
 }
 
+// RefinementOptions::slat_gap_max_m: a box free on two opposite sides with
+// its face's plane going on past a gap beyond each, where no other box
+// found lies beyond either gap, is taken out: it is a board of a pallet's
+// deck or a slat between two others (beyond a box lying flat among others
+// in a heap, one of them is found). True when a box was taken out.
+bool CheckGaps(const DetectorOptions& options, std::vector<DetectedBox>* boxes,
+               std::vector<KeptReading>* readings, std::vector<DeclinedCandidate>* declined) {
+  constexpr double kMargin = 0.015;
+  const std::vector<DetectedBox> all = *boxes;  // each judged against all
+  auto found_at = [&](const Eigen::Vector3d& p, size_t self) {
+    for (size_t j = 0; j < all.size(); ++j) {
+      if (j == self) continue;
+      const Eigen::Vector3d local = all[j].camera_T_box.inverse() * p;
+      if ((local.cwiseAbs() - 0.5 * options.box.vec()).maxCoeff() <= kMargin) return true;
+    }
+    return false;
+  };
+  // TakeOut compacts *boxes as it goes: `i` indexes the boxes as they were.
+  return TakeOut(boxes, readings, declined, [&](size_t i) -> std::string {
+    const std::array<std::optional<Eigen::Vector3d>, 4>& gap = (*readings)[i].past_gap;
+    for (int pair = 0; pair < 4; pair += 2) {
+      if (gap[pair] && gap[pair + 1] && !found_at(*gap[pair], i) && !found_at(*gap[pair + 1], i)) {
+        return "it lies between two gaps in one flat surface with no box found beyond either (a "
+               "pallet's deck board, a slat?)";
+      }
+    }
+    return "";
+  });
+}
+
 // DetectorOptions::turned_check: a box whose face reads as well turned a
 // quarter at one of its measured corners is taken out. `cleared` holds the
 // boxes checked and kept before (the checks run in rounds), not judged
 // again. True when a box was taken out.
 bool CheckTurnedReadings(const internal::HypothesisJudge& judge, const DetectorOptions& options,
-                         std::vector<DetectedBox>* boxes,
-                         std::vector<std::array<SideKind, 4>>* sides,
+                         std::vector<DetectedBox>* boxes, std::vector<KeptReading>* sides,
                          std::vector<DeclinedCandidate>* declined,
                          std::vector<Eigen::Isometry3d>* cleared) {
   auto measured = [](SideKind k) { return k == SideKind::kFree || k == SideKind::kSeam; };
   return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
     const DetectedBox& box = (*boxes)[i];
-    const std::array<SideKind, 4>& s = (*sides)[i];
+    const std::array<SideKind, 4>& s = (*sides)[i].sides;
     if (std::all_of(s.begin(), s.end(), measured)) return "";
     const Eigen::Isometry3d& T = box.camera_T_box;
     for (const Eigen::Isometry3d& c : *cleared) {
@@ -671,7 +705,7 @@ class BoxAcceptance {
       for (internal::Candidate& c : pending) {
         if (OverlapsKept(c.box.camera_T_box)) continue;
         det_->boxes.push_back(c.box);
-        sides_of_.push_back(c.refinement.sides);
+        readings_.push_back({c.refinement.sides, c.refinement.past_gap});
         if (options_.propagate_to_neighbours) {
           for (const Eigen::Isometry3d& pose :
                NeighbourHypotheses(c.box, options_.box, options_.neighbour_gap_m,
@@ -693,15 +727,15 @@ class BoxAcceptance {
     }
   }
 
-  // The side kinds of each det->boxes entry, for the plausibility checks.
-  std::vector<std::array<SideKind, 4>>* sides_of() { return &sides_of_; }
+  // The readings of each det->boxes entry, for the plausibility checks.
+  std::vector<KeptReading>* readings() { return &readings_; }
 
  private:
   const DetectorOptions& options_;
   const CancelToken& cancel_;
   internal::HypothesisJudge* const judge_;
   Detection* const det_;
-  std::vector<std::array<SideKind, 4>> sides_of_;
+  std::vector<KeptReading> readings_;
 };
 
 // Phase 5: the face tiles (after the corner hypotheses: a tile on a box
@@ -727,17 +761,19 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
   std::vector<Eigen::Isometry3d> cleared;  // CheckTurnedReadings
   auto check = [&] {
     const bool floor_removed =
-        floor && CheckFloor(*floor, options, &det->boxes, acceptance->sides_of(), declined);
+        floor && CheckFloor(*floor, options, &det->boxes, acceptance->readings(), declined);
     const bool layer_removed =
         options.faces.check_layer_tiling &&
-        CheckLayers(f.depth, options, faces, &det->boxes, acceptance->sides_of(), declined);
+        CheckLayers(f.depth, options, faces, &det->boxes, acceptance->readings(), declined);
     const bool level_removed =
         options.max_below_neighbours_m > 0.0 &&
-        CheckStandsLevel(options, &det->boxes, acceptance->sides_of(), declined);
+        CheckStandsLevel(options, &det->boxes, acceptance->readings(), declined);
+    const bool gaps_removed = options.refinement.slat_gap_max_m > 0.0 &&
+                              CheckGaps(options, &det->boxes, acceptance->readings(), declined);
     const bool turned_removed =
         options.turned_check && CheckTurnedReadings(*judge, options, &det->boxes,
-                                                    acceptance->sides_of(), declined, &cleared);
-    return floor_removed || layer_removed || level_removed || turned_removed;
+                                                    acceptance->readings(), declined, &cleared);
+    return floor_removed || layer_removed || level_removed || gaps_removed || turned_removed;
   };
   for (int round = 0; round < 3 && check(); ++round) {
     for (const LayerTiles& layer : faces.layers) {
