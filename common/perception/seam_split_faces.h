@@ -42,9 +42,10 @@ struct SeamSplitOptions {
   // apart within this. Metres, (0, 0.05].
   double size_tolerance_m = 0.015;
   // Patches whose outline has a side longer than this are not scanned: a
-  // floor or a wall (a pallet's layer is at most 1.2 x 1.2 m; a floor's
-  // scan cost 13 ms). Metres, (0, 100].
-  double max_side_m = 1.6;
+  // floor or a wall (a floor's scan cost 13 ms). A pallet's layer reaches
+  // 1.6 m (4 cartons of 0.4 m: the dev set's generator lays such grids),
+  // and its outline a little more. Metres, (0, 100].
+  double max_side_m = 2.0;
   // At most this many faces from one patch. Count, [1, 1000].
   int max_per_patch = 32;
 
