@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "common/perception/face_proposals.h"
@@ -25,6 +26,92 @@ struct Span {
   double strength;
 };
 
+// The outline rectangle turned in its plane (within +-max_deg, in steps
+// of step_deg) to where the patch's holes (no return, or behind its plane
+// by more than `behind`) line up best: the seams of a layer run along its
+// sides, but the outline of a layer cut by the image border may be the
+// border's, a few degrees off them, and a scan line then crosses each seam
+// instead of running along it. The holes' coordinates on the plane are
+// binned every 4 mm across both axes at each angle; the angle whose bins
+// are most concentrated (sum of squared counts) wins. The turned rectangle
+// covers the outline.
+PlaneRectangle AlignedToHoles(const DepthImage& depth, const PlanarPatches& patches, int patch_id,
+                              const PlaneRectangle& rect, double behind, double max_deg,
+                              double step_deg) {
+  if (max_deg <= 0.0 || step_deg <= 0.0) return rect;
+  const CameraIntrinsics& k = depth.camera;
+  // The patch's cells' bounds, in pixels.
+  int c0 = patches.cells_wide, c1 = -1, r0 = patches.cells_high, r1 = -1;
+  for (int r = 0; r < patches.cells_high; ++r) {
+    for (int c = 0; c < patches.cells_wide; ++c) {
+      if (patches.label[static_cast<size_t>(r) * patches.cells_wide + c] != patch_id) continue;
+      c0 = std::min(c0, c);
+      c1 = std::max(c1, c);
+      r0 = std::min(r0, r);
+      r1 = std::max(r1, r);
+    }
+  }
+  if (c1 < 0) return rect;
+  const int step_px = patches.step_px;
+  auto in_patch = [&](int u, int v) { return patches.PatchAt(u, v) == patch_id; };
+  const double n_c = rect.normal.dot(rect.centre);
+  // Every other pixel of every other row: a seam's holes still line up.
+  std::vector<Eigen::Vector2d> holes;
+  for (int v = r0 * step_px; v < std::min(k.height, (r1 + 1) * step_px); v += 2) {
+    for (int u = c0 * step_px + (v / 2) % 2; u < std::min(k.width, (c1 + 1) * step_px); u += 2) {
+      const Eigen::Vector3d ray = PixelRay(k, u, v);
+      const float z = depth.at(u, v);
+      if (!std::isnan(z) &&
+          (static_cast<double>(z) * ray - rect.centre).dot(rect.normal) >= -behind) {
+        continue;
+      }
+      // On the patch, or between its cells (a seam's cells are not on it).
+      const int d = 2 * step_px;
+      if (!in_patch(u, v) && !(in_patch(u - d, v) && in_patch(u + d, v)) &&
+          !(in_patch(u, v - d) && in_patch(u, v + d))) {
+        continue;
+      }
+      const double nr = rect.normal.dot(ray);
+      if (std::abs(nr) < 1e-6) continue;
+      const Eigen::Vector3d q = (n_c / nr) * ray - rect.centre;
+      holes.emplace_back(q.dot(rect.axis_u), q.dot(rect.axis_v));
+    }
+  }
+  if (holes.size() < 25) return rect;
+  constexpr double kBin = 0.004;
+  const double reach = 0.5 * std::hypot(rect.width, rect.height) + kBin;
+  const int bins = static_cast<int>(2.0 * reach / kBin) + 1;
+  std::vector<int> hu(bins), hv(bins);
+  double best_score = -1.0, best = 0.0;
+  const int steps = static_cast<int>(std::floor(max_deg / step_deg));
+  for (int i = -steps; i <= steps; ++i) {
+    const double th = i * step_deg * M_PI / 180.0, c = std::cos(th), s = std::sin(th);
+    std::fill(hu.begin(), hu.end(), 0);
+    std::fill(hv.begin(), hv.end(), 0);
+    for (const Eigen::Vector2d& h : holes) {
+      const int bu = static_cast<int>((c * h.x() + s * h.y() + reach) / kBin);
+      const int bv = static_cast<int>((-s * h.x() + c * h.y() + reach) / kBin);
+      if (bu >= 0 && bu < bins) ++hu[bu];
+      if (bv >= 0 && bv < bins) ++hv[bv];
+    }
+    double score = 0.0;
+    for (int b = 0; b < bins; ++b) score += double(hu[b]) * hu[b] + double(hv[b]) * hv[b];
+    // Ties keep the outline's own angle (i = 0 comes in the middle).
+    if (score > best_score || (score == best_score && i == 0)) {
+      best_score = score;
+      best = th;
+    }
+  }
+  if (best == 0.0) return rect;
+  PlaneRectangle turned = rect;
+  const double c = std::cos(best), s = std::sin(best);
+  turned.axis_u = c * rect.axis_u + s * rect.axis_v;
+  turned.axis_v = -s * rect.axis_u + c * rect.axis_v;
+  turned.width = std::abs(c) * rect.width + std::abs(s) * rect.height;
+  turned.height = std::abs(s) * rect.width + std::abs(c) * rect.height;
+  return turned;
+}
+
 }  // namespace
 
 absl::Status SeamSplitOptions::Validate() const {
@@ -45,6 +132,12 @@ absl::Status SeamSplitOptions::Validate() const {
   if (!(max_side_m > 0.0 && max_side_m <= 100.0)) {
     return outside("max_side_m", max_side_m, "(0, 100]");
   }
+  if (!(align_max_deg >= 0.0 && align_max_deg <= 45.0)) {
+    return outside("align_max_deg", align_max_deg, "[0, 45]");
+  }
+  if (!(align_step_deg > 0.0 && align_step_deg <= 10.0)) {
+    return outside("align_step_deg", align_step_deg, "(0, 10]");
+  }
   if (max_per_patch < 1 || max_per_patch > 1000) {
     return outside("max_per_patch", max_per_patch, "[1, 1000]");
   }
@@ -52,7 +145,7 @@ absl::Status SeamSplitOptions::Validate() const {
 }
 
 std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const PlanarPatches& patches,
-                                              int patch_id, const PlaneRectangle& rect,
+                                              int patch_id, const PlaneRectangle& outline,
                                               const BoxDims& dims, const SeamSplitOptions& o) {
   std::vector<Eigen::Isometry3d> out;
   if (!o.enabled || patch_id < 0 || patch_id >= static_cast<int>(patches.patches.size())) {
@@ -61,14 +154,19 @@ std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const Pla
   const PlanarPatch& patch = patches.patches[patch_id];
   const CameraIntrinsics& k = depth.camera;
   const double step = o.step_m;
-  if (rect.width > o.max_side_m || rect.height > o.max_side_m) return out;
+  if (outline.width > o.max_side_m || outline.height > o.max_side_m) return out;
   // Narrower than every side of the box: no face fits.
   const double shortest = std::min({dims.l, dims.b, dims.h}) - o.size_tolerance_m;
-  if (rect.width < shortest || rect.height < shortest) return out;
-  const Eigen::Vector3d corner =
-      rect.centre - 0.5 * rect.width * rect.axis_u - 0.5 * rect.height * rect.axis_v;
+  if (outline.width < shortest || outline.height < shortest) return out;
   // Behind the plane by more than its noise: a groove, or what a gap shows.
   const double behind = std::max(0.005, 3.0 * patch.rms_m);
+  // An outline the border does not cut runs along the layer's sides.
+  const PlaneRectangle rect = patch.touches_border
+                                  ? AlignedToHoles(depth, patches, patch_id, outline, behind,
+                                                   o.align_max_deg, o.align_step_deg)
+                                  : outline;
+  const Eigen::Vector3d corner =
+      rect.centre - 0.5 * rect.width * rect.axis_u - 0.5 * rect.height * rect.axis_v;
   auto pixel_of = [&](const Eigen::Vector3d& p, int* u, int* v) {
     if (p.z() <= 0.05) return false;
     const Eigen::Vector2d px = Project(k, p);

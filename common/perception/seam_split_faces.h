@@ -46,6 +46,14 @@ struct SeamSplitOptions {
   // 1.6 m (4 cartons of 0.4 m: the dev set's generator lays such grids),
   // and its outline a little more. Metres, (0, 100].
   double max_side_m = 2.0;
+  // On a patch the image border cuts, the lines run along the outline
+  // rectangle turned in its plane by up to align_max_deg (in steps of
+  // align_step_deg) to where the patch's holes line up best: the outline
+  // of a layer cut by the border may be the border's, a few degrees off
+  // the seams. 0: along the outline.
+  // Degrees, [0, 45] and (0, 10].
+  double align_max_deg = 8.0;
+  double align_step_deg = 0.5;
   // At most this many faces from one patch. Count, [1, 1000].
   int max_per_patch = 32;
 

@@ -328,6 +328,54 @@ TEST(SeamSplitFacesTest, ALayerCutByTheBorderSplitsAlongLinesOfMissingReturns) {
   EXPECT_TRUE(ProposeFromFaces(f.image, kCarton, off).poses.empty());
 }
 
+// A layer filling the whole view, turned 4 degrees from the image's axes:
+// its patch's outline is the view's own rectangle, and lines along it cross
+// every seam at 4 degrees (a line 1 m long runs 7 cm off it). Turned to
+// where the holes line up (SeamSplitOptions::align_max_deg), the lines run
+// along the seams again and the cartons they frame are proposed.
+TEST(SeamSplitFacesTest, SeamsTurnedFromALayerOutlineCutByTheBorderAreFollowed) {
+  LayerFrame f;
+  f.yaw_deg = 4.0;
+  f.width = 2.0;
+  f.height = 2.0;
+  f.centre = Eigen::Vector2d(0.0, 0.0);
+  f.Render();
+  const CameraIntrinsics& k = f.image.camera;
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const Eigen::Vector3d ray = PixelRay(k, u, v);
+      const Eigen::Vector2d q = f.ToLayer(ray.x() * kTop, ray.y() * kTop);
+      bool seam = false;
+      for (double a : {-0.5, -0.3, -0.1, 0.1, 0.3, 0.5}) seam |= std::abs(q.x() - a) < 0.0012;
+      for (double b : {-0.45, -0.15, 0.15, 0.45}) seam |= std::abs(q.y() - b) < 0.0012;
+      if (seam) f.image.z[static_cast<size_t>(v) * k.width + u] = std::nanf("");
+    }
+  }
+  // The carton between the seams a = -0.1, 0.1 and b = -0.15, 0.15 (its
+  // 0.30 m side along b), and how many proposals lie off every carton.
+  auto count = [&](const FaceProposalOptions& o, int* off_grid) {
+    int centre = 0;
+    *off_grid = 0;
+    for (const Eigen::Isometry3d& pose : ProposeFromFaces(f.image, kCarton, o).poses) {
+      const Eigen::Vector2d q = f.ToLayer(pose.translation().x(), pose.translation().y());
+      const double da = q.x() / 0.2 - std::round(q.x() / 0.2);
+      const double db = q.y() / 0.3 - std::round(q.y() / 0.3);
+      if (std::abs(da) * 0.2 > 0.01 || std::abs(db) * 0.3 > 0.01) {
+        ++*off_grid;
+        continue;
+      }
+      centre += q.norm() < 0.01;
+    }
+    return centre;
+  };
+  int off_grid = 0;
+  EXPECT_GE(count(FaceProposalOptions{}, &off_grid), 1);
+  EXPECT_EQ(off_grid, 0);
+  FaceProposalOptions along_outline;
+  along_outline.seam_split.align_max_deg = 0.0;
+  EXPECT_EQ(count(along_outline, &off_grid), 0);
+}
+
 TEST(FaceProposalsTest, TwoTilingsOfOneOutlineAreDeclinedWithoutASeamCue) {
   LayerFrame f;
   f.width = 0.6;
@@ -575,6 +623,12 @@ TEST(FaceProposalOptionsTest, ValidateNamesTheField) {
   o = {};
   o.seam_split.max_side_m = -2;
   EXPECT_NE(o.Validate().message().find("seam_split.max_side_m=-2"), std::string::npos);
+  o = {};
+  o.seam_split.align_max_deg = 60;
+  EXPECT_NE(o.Validate().message().find("seam_split.align_max_deg=60"), std::string::npos);
+  o = {};
+  o.seam_split.align_step_deg = 0;
+  EXPECT_NE(o.Validate().message().find("seam_split.align_step_deg=0"), std::string::npos);
 }
 
 }  // namespace
