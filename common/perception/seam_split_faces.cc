@@ -138,6 +138,15 @@ absl::Status SeamSplitOptions::Validate() const {
   if (!(align_step_deg > 0.0 && align_step_deg <= 10.0)) {
     return outside("align_step_deg", align_step_deg, "(0, 10]");
   }
+  if (!(colour_seam_share >= 0.0 && colour_seam_share <= 1.0)) {
+    return outside("colour_seam_share", colour_seam_share, "[0, 1]");
+  }
+  if (!(colour_flank_m > 0.0 && colour_flank_m <= 0.05)) {
+    return outside("colour_flank_m", colour_flank_m, "(0, 0.05]");
+  }
+  if (!(colour_min_contrast > 0.0 && colour_min_contrast <= 255.0)) {
+    return outside("colour_min_contrast", colour_min_contrast, "(0, 255]");
+  }
   if (max_per_patch < 1 || max_per_patch > 1000) {
     return outside("max_per_patch", max_per_patch, "[1, 1000]");
   }
@@ -185,15 +194,27 @@ std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const Pla
   // The share of each line's samples with no return or behind the plane,
   // lines across `axis` every `step` from the corner; -1 where too few of
   // its samples lie on the patch. A sample counts where the patch is, or
-  // where it is on both sides of the line (a seam's cells).
+  // where it is on both sides of the line (a seam's cells). With a grey
+  // image, *dark gets each line's share of samples darker than the image
+  // colour_flank_m to either side of the line (SeamSplitOptions::
+  // colour_seam_share): a seam the depth fills (active stereo) is a dark
+  // line in colour; the edge of tape or print is darker on one side only.
   auto scan = [&](const Eigen::Vector3d& axis, double length, const Eigen::Vector3d& across,
-                  double span) {
+                  double span, std::vector<double>* dark) {
     const int lines = static_cast<int>(length / step);
     const int samples = static_cast<int>(span / (2.0 * step));
     std::vector<double> share(std::max(lines, 0), -1.0);
+    const bool grey = dark != nullptr && depth.has_grey() && o.colour_seam_share > 0.0;
+    if (dark != nullptr) dark->assign(share.size(), -1.0);
+    auto grey_at = [&](const Eigen::Vector3d& p, float* g) {
+      int u, v;
+      if (!pixel_of(p, &u, &v)) return false;
+      *g = depth.grey_at(u, v);
+      return true;
+    };
     for (int i = 0; i < lines; ++i) {
       const double t = (i + 0.5) * step;
-      int on = 0, holes = 0;
+      int on = 0, holes = 0, darker = 0;
       for (int j = 0; j < samples; ++j) {
         const Eigen::Vector3d p = corner + t * axis + (j + 0.5) * 2.0 * step * across;
         int u, v;
@@ -211,8 +232,16 @@ std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const Pla
         }
         ++on;
         holes += hole;
+        float g = 0.0f, g0 = 0.0f, g1 = 0.0f;
+        if (grey && grey_at(p, &g) && grey_at(p - o.colour_flank_m * axis, &g0) &&
+            grey_at(p + o.colour_flank_m * axis, &g1)) {
+          darker += g <= std::min(g0, g1) - o.colour_min_contrast;
+        }
       }
-      if (on >= 20) share[i] = static_cast<double>(holes) / on;
+      if (on >= 20) {
+        share[i] = static_cast<double>(holes) / on;
+        if (grey) (*dark)[i] = static_cast<double>(darker) / on;
+      }
     }
     return share;
   };
@@ -221,7 +250,16 @@ std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const Pla
   auto stops_along = [&](const Eigen::Vector3d& axis, double length, const Eigen::Vector3d& across,
                          double span) {
     std::vector<Stop> stops;
-    const std::vector<double> share = scan(axis, length, across, span);
+    std::vector<double> dark;
+    const std::vector<double> share = scan(axis, length, across, span, &dark);
+    // Colour seams: lines darker than both flanks along most of their
+    // length, each the darkest of its neighbours.
+    for (size_t i = 0; i < dark.size(); ++i) {
+      const double d = dark[i];
+      if (d < o.colour_seam_share) continue;
+      if ((i > 0 && dark[i - 1] > d) || (i + 1 < dark.size() && dark[i + 1] >= d)) continue;
+      stops.push_back({(i + 0.5) * step, d});
+    }
     std::vector<double> valid;
     for (double s : share) {
       if (s >= 0.0) valid.push_back(s);
@@ -235,7 +273,13 @@ std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const Pla
       if (s < needed) continue;
       // The line's best: not lower than the one before, higher than the next.
       if ((i > 0 && share[i - 1] > s) || (i + 1 < share.size() && share[i + 1] >= s)) continue;
-      stops.push_back({(i + 0.5) * step, s});
+      const double at = (i + 0.5) * step;
+      // The same seam in colour and in depth is one stop.
+      if (std::any_of(stops.begin(), stops.end(),
+                      [&](const Stop& c) { return std::abs(c.at - at) <= 0.004; })) {
+        continue;
+      }
+      stops.push_back({at, s});
     }
     constexpr double kBorderPx = 6.0;
     for (double at : {0.0, length}) {

@@ -54,6 +54,16 @@ struct SeamSplitOptions {
   // Degrees, [0, 45] and (0, 10].
   double align_max_deg = 8.0;
   double align_step_deg = 0.5;
+  // With a registered grey image, a line is a seam too when at least this
+  // share of its samples on the patch is darker, by colour_min_contrast
+  // grey levels, than the image colour_flank_m to either side of the line:
+  // a seam the depth does not show (active stereo fills it) is a dark line
+  // along the whole layer; the edges of tape, labels and print are darker
+  // on one side only, or along part of a line. 0: depth seams only.
+  // Unitless [0, 1], metres (0, 0.05], grey levels (0, 255].
+  double colour_seam_share = 0.5;
+  double colour_flank_m = 0.01;
+  double colour_min_contrast = 4.0;
   // At most this many faces from one patch. Count, [1, 1000].
   int max_per_patch = 32;
 

@@ -328,6 +328,45 @@ TEST(SeamSplitFacesTest, ALayerCutByTheBorderSplitsAlongLinesOfMissingReturns) {
   EXPECT_TRUE(ProposeFromFaces(f.image, kCarton, off).poses.empty());
 }
 
+// The layer of ALayerCutByTheBorderSplitsAlongLinesOfMissingReturns, its
+// seams filled in the depth (active stereo smooths them away) and plain
+// only in colour: dark lines along the whole layer, with a darker tape
+// strip and a label on the cartons. Each seam is a line darker than the
+// image a centimetre to either side (SeamSplitOptions::colour_seam_share);
+// the tape's and the label's edges are darker on one side only. The nine
+// cartons are proposed; with colour seams off, none.
+TEST(SeamSplitFacesTest, SeamsOnlyTheColourShowsSplitALayerCutByTheBorder) {
+  LayerFrame f;
+  f.yaw_deg = 8.0;
+  f.width = 0.6;
+  f.height = 1.6;
+  f.centre = Eigen::Vector2d(0.01, 0.0);
+  f.Render();
+  // Tape along the middle column's cartons (5 cm wide) and a label.
+  f.Paint({-0.1, 0.1}, {-0.45, -0.15, 0.15, 0.45},
+          {Eigen::Vector4d(-0.025, -0.8, 0.025, 0.8), Eigen::Vector4d(0.12, 0.02, 0.22, 0.1)});
+  auto proposed = [&](double share) {
+    FaceProposalOptions o;
+    o.seam_split.colour_seam_share = share;
+    const std::vector<Eigen::Isometry3d> poses = ProposeFromFaces(f.image, kCarton, o).poses;
+    std::vector<int> seen(9, 0);
+    for (const Eigen::Isometry3d& pose : poses) {
+      const Eigen::Vector2d q = f.ToLayer(pose.translation().x(), pose.translation().y());
+      const int i = static_cast<int>(std::lround(q.x() / 0.2)) + 1;
+      const int j = static_cast<int>(std::lround(q.y() / 0.3)) + 1;
+      if (i < 0 || i > 2 || j < 0 || j > 2 ||
+          (q - Eigen::Vector2d((i - 1) * 0.2, (j - 1) * 0.3)).norm() > 0.01) {
+        ADD_FAILURE() << "a proposal off every carton at " << q.transpose();
+        continue;
+      }
+      ++seen[3 * j + i];
+    }
+    return static_cast<int>(std::count_if(seen.begin(), seen.end(), [](int n) { return n > 0; }));
+  };
+  EXPECT_EQ(proposed(0.5), 9);
+  EXPECT_EQ(proposed(0.0), 0);
+}
+
 // A layer filling the whole view, turned 4 degrees from the image's axes:
 // its patch's outline is the view's own rectangle, and lines along it cross
 // every seam at 4 degrees (a line 1 m long runs 7 cm off it). Turned to
@@ -629,6 +668,15 @@ TEST(FaceProposalOptionsTest, ValidateNamesTheField) {
   o = {};
   o.seam_split.align_step_deg = 0;
   EXPECT_NE(o.Validate().message().find("seam_split.align_step_deg=0"), std::string::npos);
+  o = {};
+  o.seam_split.colour_seam_share = 2;
+  EXPECT_NE(o.Validate().message().find("seam_split.colour_seam_share=2"), std::string::npos);
+  o = {};
+  o.seam_split.colour_flank_m = 0;
+  EXPECT_NE(o.Validate().message().find("seam_split.colour_flank_m=0"), std::string::npos);
+  o = {};
+  o.seam_split.colour_min_contrast = -1;
+  EXPECT_NE(o.Validate().message().find("seam_split.colour_min_contrast=-1"), std::string::npos);
 }
 
 }  // namespace
