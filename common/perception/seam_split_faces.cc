@@ -232,10 +232,13 @@ std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const Pla
         }
         ++on;
         holes += hole;
-        float g = 0.0f, g0 = 0.0f, g1 = 0.0f;
-        if (grey && grey_at(p, &g) && grey_at(p - o.colour_flank_m * axis, &g0) &&
-            grey_at(p + o.colour_flank_m * axis, &g1)) {
-          darker += g <= std::min(g0, g1) - o.colour_min_contrast;
+        // The sample's own pixel (u, v); a flank read only while it can
+        // still be darker than both.
+        float g0 = 0.0f, g1 = 0.0f;
+        if (grey) {
+          const float g = depth.grey_at(u, v) + static_cast<float>(o.colour_min_contrast);
+          darker += grey_at(p - o.colour_flank_m * axis, &g0) && g <= g0 &&
+                    grey_at(p + o.colour_flank_m * axis, &g1) && g <= g1;
         }
       }
       if (on >= 20) {
