@@ -27,14 +27,28 @@ struct Span {
 };
 
 // The outline rectangle turned in its plane (within +-max_deg, in steps
-// of step_deg) to where the patch's holes (no return, or behind its plane
-// by more than `behind`) line up best: the seams of a layer run along its
-// sides, but the outline of a layer cut by the image border may be the
-// border's, a few degrees off them, and a scan line then crosses each seam
-// instead of running along it. The holes' coordinates on the plane are
-// binned every 4 mm across both axes at each angle; the angle whose bins
-// are most concentrated (sum of squared counts) wins. The turned rectangle
-// covers the outline.
+// of step_deg) to where the patch's holes (no return, behind its plane by
+// more than `behind`, or a thin dark line in the grey image) line up best:
+// the seams of a layer run along its sides, but the outline of a layer cut
+// by the image border may be the border's, off them, and a scan line then
+// crosses each seam instead of running along it. The holes' coordinates on
+// the plane are binned every 4 mm across both axes at each angle; the
+// angle whose bins are most concentrated (sum of squared counts) wins. The
+// turned rectangle covers the outline.
+// A pixel of a thin dark line in the grey image (a seam the depth fills):
+// darker by kContrast grey levels than the pixels kReach to either side of
+// it across a row or a column. Never with no grey image.
+bool DarkLine(const DepthImage& depth, int u, int v) {
+  constexpr int kReach = 3;
+  constexpr float kContrast = 6.0f;
+  if (!depth.has_grey()) return false;
+  const CameraIntrinsics& k = depth.camera;
+  if (u < kReach || v < kReach || u >= k.width - kReach || v >= k.height - kReach) return false;
+  const float g = depth.grey_at(u, v) + kContrast;
+  return (g <= depth.grey_at(u - kReach, v) && g <= depth.grey_at(u + kReach, v)) ||
+         (g <= depth.grey_at(u, v - kReach) && g <= depth.grey_at(u, v + kReach));
+}
+
 PlaneRectangle AlignedToHoles(const DepthImage& depth, const PlanarPatches& patches, int patch_id,
                               const PlaneRectangle& rect, double behind, double max_deg,
                               double step_deg) {
@@ -62,7 +76,8 @@ PlaneRectangle AlignedToHoles(const DepthImage& depth, const PlanarPatches& patc
       const Eigen::Vector3d ray = PixelRay(k, u, v);
       const float z = depth.at(u, v);
       if (!std::isnan(z) &&
-          (static_cast<double>(z) * ray - rect.centre).dot(rect.normal) >= -behind) {
+          (static_cast<double>(z) * ray - rect.centre).dot(rect.normal) >= -behind &&
+          !DarkLine(depth, u, v)) {
         continue;
       }
       // On the patch, or between its cells (a seam's cells are not on it).
@@ -82,10 +97,8 @@ PlaneRectangle AlignedToHoles(const DepthImage& depth, const PlanarPatches& patc
   const double reach = 0.5 * std::hypot(rect.width, rect.height) + kBin;
   const int bins = static_cast<int>(2.0 * reach / kBin) + 1;
   std::vector<int> hu(bins), hv(bins);
-  double best_score = -1.0, best = 0.0;
-  const int steps = static_cast<int>(std::floor(max_deg / step_deg));
-  for (int i = -steps; i <= steps; ++i) {
-    const double th = i * step_deg * M_PI / 180.0, c = std::cos(th), s = std::sin(th);
+  auto score_at = [&](double deg) {
+    const double th = deg * M_PI / 180.0, c = std::cos(th), s = std::sin(th);
     std::fill(hu.begin(), hu.end(), 0);
     std::fill(hv.begin(), hv.end(), 0);
     for (const Eigen::Vector2d& h : holes) {
@@ -96,12 +109,26 @@ PlaneRectangle AlignedToHoles(const DepthImage& depth, const PlanarPatches& patc
     }
     double score = 0.0;
     for (int b = 0; b < bins; ++b) score += double(hu[b]) * hu[b] + double(hv[b]) * hv[b];
-    // Ties keep the outline's own angle (i = 0 comes in the middle).
-    if (score > best_score || (score == best_score && i == 0)) {
+    return score;
+  };
+  // Coarse steps of 4 fine ones over the range, then the fine steps around
+  // the best; ties keep the angle nearer the outline's own.
+  double best_score = -1.0, best_deg = 0.0;
+  auto consider = [&](double deg) {
+    const double score = score_at(deg);
+    if (score > best_score || (score == best_score && std::abs(deg) < std::abs(best_deg))) {
       best_score = score;
-      best = th;
+      best_deg = deg;
     }
+  };
+  const double coarse = 4.0 * step_deg;
+  const int coarse_steps = static_cast<int>(std::floor(max_deg / coarse));
+  for (int i = -coarse_steps; i <= coarse_steps; ++i) consider(i * coarse);
+  const double around = best_deg;
+  for (int i = -3; i <= 3; ++i) {
+    if (i != 0 && std::abs(around + i * step_deg) <= max_deg) consider(around + i * step_deg);
   }
+  const double best = best_deg * M_PI / 180.0;
   if (best == 0.0) return rect;
   PlaneRectangle turned = rect;
   const double c = std::cos(best), s = std::sin(best);

@@ -47,12 +47,13 @@ struct SeamSplitOptions {
   // and its outline a little more. Metres, (0, 100].
   double max_side_m = 2.0;
   // On a patch the image border cuts, the lines run along the outline
-  // rectangle turned in its plane by up to align_max_deg (in steps of
-  // align_step_deg) to where the patch's holes line up best: the outline
-  // of a layer cut by the border may be the border's, a few degrees off
-  // the seams. 0: along the outline.
+  // rectangle turned in its plane by up to align_max_deg (in steps of four
+  // align_step_deg, then of one around the best) to where the patch's holes
+  // and the grey image's thin dark lines line up best: the outline of a
+  // layer cut by the border may be the border's, far off the seams. 0:
+  // along the outline.
   // Degrees, [0, 45] and (0, 10].
-  double align_max_deg = 8.0;
+  double align_max_deg = 45.0;
   double align_step_deg = 0.5;
   // With a registered grey image, a line is a seam too when at least this
   // share of its samples on the patch is darker, by colour_min_contrast

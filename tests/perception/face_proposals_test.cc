@@ -415,6 +415,33 @@ TEST(SeamSplitFacesTest, SeamsTurnedFromALayerOutlineCutByTheBorderAreFollowed) 
   EXPECT_EQ(count(along_outline, &off_grid), 0);
 }
 
+// The same, turned 30 degrees, its seams filled in the depth and plain
+// only in colour (active stereo): the holes that line up are the colour
+// image's thin dark lines, and the outline (the view's rectangle) is 30
+// degrees off them, past a search of 8 degrees but within 45.
+TEST(SeamSplitFacesTest, ColourSeamsFarOffALayerOutlineCutByTheBorderAreFollowed) {
+  LayerFrame f;
+  f.yaw_deg = 30.0;
+  f.width = 2.4;
+  f.height = 2.4;
+  f.centre = Eigen::Vector2d(0.0, 0.0);
+  f.Render();
+  f.Paint({-0.7, -0.5, -0.3, -0.1, 0.1, 0.3, 0.5, 0.7},
+          {-1.05, -0.75, -0.45, -0.15, 0.15, 0.45, 0.75, 1.05});
+  auto centre_proposed = [&](double max_deg) {
+    FaceProposalOptions o;
+    o.seam_split.align_max_deg = max_deg;
+    int centre = 0;
+    for (const Eigen::Isometry3d& pose : ProposeFromFaces(f.image, kCarton, o).poses) {
+      const Eigen::Vector2d q = f.ToLayer(pose.translation().x(), pose.translation().y());
+      centre += q.norm() < 0.01;
+    }
+    return centre;
+  };
+  EXPECT_GE(centre_proposed(45.0), 1);
+  EXPECT_EQ(centre_proposed(8.0), 0);
+}
+
 TEST(FaceProposalsTest, TwoTilingsOfOneOutlineAreDeclinedWithoutASeamCue) {
   LayerFrame f;
   f.width = 0.6;
