@@ -778,6 +778,20 @@ void ColourSeamSide(const DepthImage& depth, const FaceFrame& f, bool along_a, d
   }
 }
 
+// The surface measured where point q (on or near the face's plane)
+// projects: its height above the plane along `normal` (NaN where the pixel
+// has no return), or nothing when q is behind the camera or out of view.
+std::optional<double> HeightAt(const DepthImage& depth, const Eigen::Vector3d& q,
+                               const Eigen::Vector3d& normal) {
+  if (q.z() <= 0.05) return std::nullopt;
+  const Eigen::Vector2d px = Project(depth.camera, q);
+  const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+  if (!depth.inside(u, v)) return std::nullopt;
+  const float z = depth.at(u, v);
+  if (std::isnan(z)) return std::numeric_limits<double>::quiet_NaN();
+  return (z * PixelRay(depth.camera, u, v) - q).dot(normal);
+}
+
 // True when, past a side, the first surface after a run of missing returns
 // lies in front of the face's plane (the gap is the shadow of something
 // standing over the face), or the first surface right at the side (past the
@@ -795,15 +809,10 @@ bool ShadowedByOccluder(const DepthImage& depth, const Eigen::Vector3d& side_cen
   for (double t : {-0.6, 0.0, 0.6}) {
     const Eigen::Vector3d start = side_centre + t * half_along * along;
     for (double d = 0.004; d < 0.08; d += 0.003) {
-      const Eigen::Vector3d q = start + d * across;
-      if (q.z() <= 0.05) break;
-      const Eigen::Vector2d px = Project(depth.camera, q);
-      const int u = static_cast<int>(std::lround(px.x())),
-                v = static_cast<int>(std::lround(px.y()));
-      if (!depth.inside(u, v)) break;
-      const float z = depth.at(u, v);
-      if (std::isnan(z)) continue;
-      const double height = (z * PixelRay(depth.camera, u, v) - q).dot(normal);
+      const std::optional<double> h = HeightAt(depth, start + d * across, normal);
+      if (!h) break;
+      if (std::isnan(*h)) continue;
+      const double height = *h;
       // Within the side's blur (mixed pixels, a side measured a few
       // millimetres short) the face itself may still show: look past it.
       if (std::abs(height) <= o.plane_tolerance_m && d <= 0.012) continue;
@@ -834,17 +843,10 @@ std::optional<Eigen::Vector3d> PlaneGoesOnPastGap(const DepthImage& depth,
     const Eigen::Vector3d start = side_centre + t * half_along * along;
     int off = 0, on = 0;
     for (double d = 0.004; d <= o.slat_gap_max_m + kStep; d += kStep) {
-      const Eigen::Vector3d q = start + d * across;
-      if (q.z() <= 0.05) break;
-      const Eigen::Vector2d px = Project(depth.camera, q);
-      const int u = static_cast<int>(std::lround(px.x())),
-                v = static_cast<int>(std::lround(px.y()));
-      if (!depth.inside(u, v)) break;
-      const float z = depth.at(u, v);
-      double height = std::numeric_limits<double>::infinity();  // no return: off the plane
-      if (!std::isnan(z)) height = (z * PixelRay(depth.camera, u, v) - q).dot(normal);
-      if (std::isfinite(height) && height > o.plane_tolerance_m) break;  // something in front
-      if (std::abs(height) > o.plane_tolerance_m) {
+      const std::optional<double> h = HeightAt(depth, start + d * across, normal);
+      if (!h) break;
+      if (*h > o.plane_tolerance_m) break;           // something in front
+      if (!(std::abs(*h) <= o.plane_tolerance_m)) {  // off the plane, or no return
         ++off;
         on = 0;
         continue;
@@ -875,20 +877,11 @@ std::optional<double> DistanceToPlaneEnd(const DepthImage& depth, const Eigen::V
   constexpr int kOffPlaneToEnd = 4;  // consecutive samples off the plane (1.6 cm)
   int off = 0;
   for (double d = kStep; d < o.max_tile_march_m; d += kStep) {
-    const Eigen::Vector3d q = start + d * dir;
-    if (q.z() <= 0.05) return std::nullopt;
-    const Eigen::Vector2d px = Project(depth.camera, q);
-    const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
-    if (!depth.inside(u, v)) return std::nullopt;
-    const float z = depth.at(u, v);
-    bool on_plane = false;
-    if (!std::isnan(z)) {
-      const Eigen::Vector3d m = z * PixelRay(depth.camera, u, v);
-      const double height = (m - q).dot(normal);
-      // Something in front hides where the plane ends.
-      if (height > o.plane_tolerance_m) return std::nullopt;
-      on_plane = std::abs(height) < o.plane_tolerance_m;
-    }
+    const std::optional<double> h = HeightAt(depth, start + d * dir, normal);
+    if (!h) return std::nullopt;
+    // Something in front hides where the plane ends.
+    if (*h > o.plane_tolerance_m) return std::nullopt;
+    const bool on_plane = std::abs(*h) < o.plane_tolerance_m;  // no return (NaN): off it
     off = on_plane ? 0 : off + 1;
     if (off == kOffPlaneToEnd) return d - (kOffPlaneToEnd - 0.5) * kStep;
   }
