@@ -70,7 +70,7 @@ struct KeptReading {
 
 // Takes out the boxes (and their readings) for which `why(i)` gives a
 // reason, declining each with it. True when one was taken out.
-bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<KeptReading>* sides,
+bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<KeptReading>* readings,
              std::vector<DeclinedCandidate>* declined,
              const std::function<std::string(size_t)>& why) {
   size_t kept = 0;
@@ -80,12 +80,12 @@ bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<KeptReading>* sides,
       continue;
     }
     (*boxes)[kept] = (*boxes)[i];
-    (*sides)[kept] = (*sides)[i];
+    (*readings)[kept] = (*readings)[i];
     ++kept;
   }
   const bool removed = kept < boxes->size();
   boxes->resize(kept);
-  sides->resize(kept);
+  readings->resize(kept);
   return removed;
 }
 
@@ -175,10 +175,10 @@ std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptio
 // box of another size read as this one on end). True when a box was taken
 // out.
 bool CheckFloor(const FloorPlane& floor, const DetectorOptions& options,
-                std::vector<DetectedBox>* boxes, std::vector<KeptReading>* sides,
+                std::vector<DetectedBox>* boxes, std::vector<KeptReading>* readings,
                 std::vector<DeclinedCandidate>* declined) {
   const BoxDims& d = options.box;
-  return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
+  return TakeOut(boxes, readings, declined, [&](size_t i) -> std::string {
     const Eigen::Isometry3d& pose = (*boxes)[i].camera_T_box;
     double deepest = -std::numeric_limits<double>::max();
     for (int c = 0; c < 8; ++c) {
@@ -203,7 +203,8 @@ bool CheckFloor(const FloorPlane& floor, const DetectorOptions& options,
 // a heap, a box on end stands as level with it. True when a box was taken
 // out.
 bool CheckStandsLevel(const DetectorOptions& options, std::vector<DetectedBox>* boxes,
-                      std::vector<KeptReading>* sides, std::vector<DeclinedCandidate>* declined) {
+                      std::vector<KeptReading>* readings,
+                      std::vector<DeclinedCandidate>* declined) {
   constexpr int kLayerNeighbours = 2;
   const BoxDims& d = options.box;
   const double tol = options.max_below_neighbours_m;
@@ -220,7 +221,7 @@ bool CheckStandsLevel(const DetectorOptions& options, std::vector<DetectedBox>* 
   const double largest_half_diagonal =
       0.5 * std::max({std::hypot(d.l, d.b), std::hypot(d.l, d.h), std::hypot(d.b, d.h)});
   const double cos_parallel = std::cos(12.0 * M_PI / 180.0);
-  return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
+  return TakeOut(boxes, readings, declined, [&](size_t i) -> std::string {
     const DetectedBox& b = (*boxes)[i];
     int level = 0;
     double deepest = 0.0;
@@ -259,7 +260,7 @@ bool CheckStandsLevel(const DetectorOptions& options, std::vector<DetectedBox>* 
 // nothing. True when a box was taken out.
 bool CheckLayers(const DepthImage& depth, const DetectorOptions& options,
                  const FaceProposals& faces, std::vector<DetectedBox>* boxes,
-                 std::vector<KeptReading>* sides, std::vector<DeclinedCandidate>* declined) {
+                 std::vector<KeptReading>* readings, std::vector<DeclinedCandidate>* declined) {
   const size_t n = boxes->size();
   std::vector<int> layer(n, -1);
   std::vector<bool> trusted(faces.layers.size(), false);
@@ -270,13 +271,13 @@ bool CheckLayers(const DepthImage& depth, const DetectorOptions& options,
         LayerUnder(faces, depth, b.grasp_centre_camera, b.grasp_normal_camera, options.faces);
     if (layer[i] < 0) continue;
     tile[i] = IsLayerTile(faces.layers[layer[i]], options.box, b.camera_T_box, options.faces);
-    const std::array<SideKind, 4>& s = (*sides)[i].sides;
+    const std::array<SideKind, 4>& s = (*readings)[i].sides;
     const bool free_a = s[0] == SideKind::kFree || s[1] == SideKind::kFree;
     const bool free_b = s[2] == SideKind::kFree || s[3] == SideKind::kFree;
     if (tile[i] && free_a && free_b) trusted[layer[i]] = true;
   }
-  return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
-    const std::array<SideKind, 4>& s = (*sides)[i].sides;
+  return TakeOut(boxes, readings, declined, [&](size_t i) -> std::string {
+    const std::array<SideKind, 4>& s = (*readings)[i].sides;
     const bool bounded_by_seams = std::any_of(s.begin(), s.end(), [](SideKind k) {
       return k == SideKind::kSeam || k == SideKind::kTiled || k == SideKind::kContinues;
     });
@@ -324,13 +325,13 @@ bool CheckGaps(const DetectorOptions& options, std::vector<DetectedBox>* boxes,
 // boxes checked and kept before (the checks run in rounds), not judged
 // again. True when a box was taken out.
 bool CheckTurnedReadings(const internal::HypothesisJudge& judge, const DetectorOptions& options,
-                         std::vector<DetectedBox>* boxes, std::vector<KeptReading>* sides,
+                         std::vector<DetectedBox>* boxes, std::vector<KeptReading>* readings,
                          std::vector<DeclinedCandidate>* declined,
                          std::vector<Eigen::Isometry3d>* cleared) {
   auto measured = [](SideKind k) { return k == SideKind::kFree || k == SideKind::kSeam; };
-  return TakeOut(boxes, sides, declined, [&](size_t i) -> std::string {
+  return TakeOut(boxes, readings, declined, [&](size_t i) -> std::string {
     const DetectedBox& box = (*boxes)[i];
-    const std::array<SideKind, 4>& s = (*sides)[i].sides;
+    const std::array<SideKind, 4>& s = (*readings)[i].sides;
     if (std::all_of(s.begin(), s.end(), measured)) return "";
     const Eigen::Isometry3d& T = box.camera_T_box;
     for (const Eigen::Isometry3d& c : *cleared) {

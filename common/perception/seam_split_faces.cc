@@ -282,14 +282,21 @@ std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const Pla
     std::vector<Stop> stops;
     std::vector<double> dark;
     const std::vector<double> share = scan(axis, length, across, span, &dark);
+    // The lines whose value reaches `needed` and is their neighbours' best:
+    // not lower than the one before, higher than the next.
+    auto peaks = [&](const std::vector<double>& value, double needed) {
+      std::vector<Stop> out;
+      for (size_t i = 0; i < value.size(); ++i) {
+        const double x = value[i];
+        if (x < needed) continue;
+        if ((i > 0 && value[i - 1] > x) || (i + 1 < value.size() && value[i + 1] >= x)) continue;
+        out.push_back({(i + 0.5) * step, x});
+      }
+      return out;
+    };
     // Colour seams: lines darker than both flanks along most of their
-    // length, each the darkest of its neighbours.
-    for (size_t i = 0; i < dark.size(); ++i) {
-      const double d = dark[i];
-      if (d < o.colour_seam_share) continue;
-      if ((i > 0 && dark[i - 1] > d) || (i + 1 < dark.size() && dark[i + 1] >= d)) continue;
-      stops.push_back({(i + 0.5) * step, d});
-    }
+    // length.
+    stops = peaks(dark, o.colour_seam_share);
     std::vector<double> valid;
     for (double s : share) {
       if (s >= 0.0) valid.push_back(s);
@@ -298,18 +305,12 @@ std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const Pla
     std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
     const double floor = std::max(valid[valid.size() / 2], 0.01);
     const double needed = std::max(o.min_seam_share, o.min_seam_ratio * floor);
-    for (size_t i = 0; i < share.size(); ++i) {
-      const double s = share[i];
-      if (s < needed) continue;
-      // The line's best: not lower than the one before, higher than the next.
-      if ((i > 0 && share[i - 1] > s) || (i + 1 < share.size() && share[i + 1] >= s)) continue;
-      const double at = (i + 0.5) * step;
+    for (const Stop& seam : peaks(share, needed)) {
       // The same seam in colour and in depth is one stop.
-      if (std::any_of(stops.begin(), stops.end(),
-                      [&](const Stop& c) { return std::abs(c.at - at) <= 0.004; })) {
-        continue;
+      if (std::none_of(stops.begin(), stops.end(),
+                       [&](const Stop& c) { return std::abs(c.at - seam.at) <= 0.004; })) {
+        stops.push_back(seam);
       }
-      stops.push_back({at, s});
     }
     constexpr double kBorderPx = 6.0;
     for (double at : {0.0, length}) {
