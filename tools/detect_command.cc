@@ -121,6 +121,10 @@ constexpr char kHelp[] =
     "  --leaving_view N     a face the image border cuts is returned when free sides or\n"
     "                       seams end it all round, with a free side on N of its two\n"
     "                       axes (1; 2: on both; 0: seams suffice)\n"
+    "  --out_of_view BOOL   a face the border cuts on one side is returned when its\n"
+    "                       other sides end it and it is seen to the border longer\n"
+    "                       than any shorter side of the box, over 60% of its length\n"
+    "                       (true)\n"
     "  --retry_declined BOOL a pose refined and declined is judged once more when\n"
     "                       proposed again from another start (true)\n"
     "  --patch_window N     planar patches: a cell's normal from (2N+1)^2 cells of 4 px\n"
@@ -174,6 +178,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetInt("max_declined", &options.max_declined),
         args.SetBool("border_faces", &options.faces.propose_at_border),
         args.SetInt("leaving_view", &options.acceptance.leaving_view_free_axes),
+        args.SetBool("out_of_view", &options.acceptance.face_may_run_out_of_view),
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("seam_split", &options.faces.seam_split.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
@@ -291,6 +296,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "side_allowance",
                                                        "border_faces",
                                                        "leaving_view",
+                                                       "out_of_view",
                                                        "anchored_faces",
                                                        "seam_split",
                                                        "rim_sides",

@@ -28,6 +28,7 @@
 #include "common/perception/camera_model.h"
 #include "common/perception/detector.h"
 #include "common/perception/face_proposals.h"
+#include "common/perception/internal/border_faces.h"
 #include "common/perception/internal/hypothesis_judge.h"
 #include "nlohmann/json.hpp"
 #include "tools/command_args.h"
@@ -72,10 +73,17 @@ BoxFace JudgeOne(const DepthImage& depth, const DetectorOptions& options,
               ref.ok ? "ok" : "FAILED", 1000.0 * moved.norm(), turned, SideName(ref.sides[0]),
               SideName(ref.sides[1]), SideName(ref.sides[2]), SideName(ref.sides[3]),
               1000.0 * ref.plane_rms_m);
+  // A side out of view that what is in view pins (internal/border_faces.h).
+  const int out_of_view =
+      options.acceptance.face_may_run_out_of_view
+          ? internal::SideOutOfViewPinned(depth, refined, first.grasp_face, options.box, ref,
+                                          options.acceptance, options.refinement.plane_tolerance_m)
+          : -1;
+  if (out_of_view >= 0) std::printf(", side %d out of view pinned", out_of_view);
   const BoxEvidence ev = MeasureBox(depth, refined, options.box, options.evidence);
   std::string reason;
-  const double score =
-      internal::JudgeRefined(ev, ref, options.box, first.grasp_face, options.acceptance, &reason);
+  const double score = internal::JudgeRefined(ev, ref, options.box, first.grasp_face,
+                                              options.acceptance, &reason, out_of_view);
   if (per_face) {
     for (int fi = 0; fi < 6; ++fi) {
       const FaceEvidence& e = ev.faces[fi];

@@ -10,10 +10,13 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/perception/internal/height_at.h"
 #include "common/validation/range_check.h"
 
 namespace cornerpose {
 namespace {
+
+using internal::HeightAt;
 
 double Median(std::vector<double>& v) {
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
@@ -776,20 +779,6 @@ void ColourSeamSide(const DepthImage& depth, const FaceFrame& f, bool along_a, d
     const double cap = std::tan(o.seam_turn_max_deg * std::numbers::pi / 180.0);
     m->seam_slope = std::clamp(*cue.slope, -cap, cap);
   }
-}
-
-// The surface measured where point q (on or near the face's plane)
-// projects: its height above the plane along `normal` (NaN where the pixel
-// has no return), or nothing when q is behind the camera or out of view.
-std::optional<double> HeightAt(const DepthImage& depth, const Eigen::Vector3d& q,
-                               const Eigen::Vector3d& normal) {
-  if (q.z() <= 0.05) return std::nullopt;
-  const Eigen::Vector2d px = Project(depth.camera, q);
-  const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
-  if (!depth.inside(u, v)) return std::nullopt;
-  const float z = depth.at(u, v);
-  if (std::isnan(z)) return std::numeric_limits<double>::quiet_NaN();
-  return (z * PixelRay(depth.camera, u, v) - q).dot(normal);
 }
 
 // True when, past a side, the first surface after a run of missing returns

@@ -423,6 +423,7 @@ absl::Status AcceptanceOptions::Validate() const {
            CheckRange("acceptance.max_grasp_view_angle_deg", max_grasp_view_angle_deg, 0.0, 90.0),
            CheckRange("acceptance.border_margin_px", border_margin_px, 0.0, 1000.0),
            CheckRange("acceptance.leaving_view_free_axes", leaving_view_free_axes, 0, 2),
+           CheckPositive("acceptance.min_in_view_share", min_in_view_share, 1.0),
            CheckRange("acceptance.overlap_margin_m", overlap_margin_m, 0.0, 1.0),
            CheckRange("acceptance.settled_overlap_margin_m", settled_overlap_margin_m, 0.0, 1.0),
        }) {

@@ -69,6 +69,17 @@ struct AcceptanceOptions {
   // fourteenth round); 2: a free side on each axis (the rule before session
   // 17); 0: seams on all four suffice. Count, [0, 2].
   int leaving_view_free_axes = 1;
+  // A face the image border cuts across one axis is returned when its
+  // other three sides were measured (free or a seam) and it is seen on its
+  // plane from its measured end to the border for longer than any shorter
+  // side of the box that could stand there, over at least
+  // min_in_view_share of its length (internal/border_faces.h): the known
+  // size and the measured end say where it ends out of view. The cartons at
+  // the edge of a view a pallet layer fills. False: such faces are
+  // declined ("grasp face cut by the image border").
+  bool face_may_run_out_of_view = true;
+  // Share of the cut side's length that must be in view. Unitless, (0, 1].
+  double min_in_view_share = 0.6;
   // Two accepted boxes may not overlap by more than this (each is shrunk by
   // it before the overlap test). Metres.
   double overlap_margin_m = 0.015;

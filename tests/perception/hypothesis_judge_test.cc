@@ -176,20 +176,27 @@ TEST(HypothesisJudgeTest, AHypothesisDeepInsideAKeptBoxIsNotJudged) {
 // some of each side are in view goes on to refinement when a face measured
 // on every side may leave the view (the final check then decides); with
 // that rule off, the first look drops it, as before; and so it does, rule
-// or not, when a whole side is out of view (that side cannot be measured).
+// or not, when a whole side is out of view (that side cannot be measured),
+// unless the face may run out of view on one side
+// (AcceptanceOptions::face_may_run_out_of_view).
 // With the principal point at u = 64 the face's far-left corner lies at
 // u = -24 and its left side's upper quarter point at u = 3; at u = 30 the
 // whole left side is out.
 TEST(HypothesisJudgeTest, AFaceLeavingTheViewIsRefinedWhenItMayBeMeasuredThere) {
   const RenderedDepth out_a_side = RenderOneBox(/*cx=*/30.0);
   for (const bool may_leave : {true, false}) {
-    DetectorOptions o;
-    o.box = kCartonS;
-    o.acceptance.measured_face_may_leave_view = may_leave;
-    internal::HypothesisJudge judge(out_a_side.depth, o);
-    judge.Propose(out_a_side.out.boxes.at(0).camera_T_box, 0, {});
-    judge.Evaluate(1);
-    EXPECT_EQ(judge.stats().refined, 0) << may_leave;
+    for (const bool may_run_out : {true, false}) {
+      DetectorOptions o;
+      o.box = kCartonS;
+      o.acceptance.measured_face_may_leave_view = may_leave;
+      o.acceptance.face_may_run_out_of_view = may_run_out;
+      internal::HypothesisJudge judge(out_a_side.depth, o);
+      judge.Propose(out_a_side.out.boxes.at(0).camera_T_box, 0, {});
+      judge.Evaluate(1);
+      // A face with one side out of view and its middle in view may be
+      // pinned up to the border (internal/border_faces.h): refined.
+      EXPECT_EQ(judge.stats().refined, may_leave && may_run_out ? 1 : 0) << may_leave;
+    }
   }
   const RenderedDepth b = RenderOneBox(/*cx=*/64.0);
   const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;

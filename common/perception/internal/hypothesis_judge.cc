@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "absl/strings/str_format.h"
+#include "common/perception/internal/border_faces.h"
 #include "common/perception/internal/box_overlap.h"
 #include "common/perception/internal/parallel.h"
 #include "common/perception/pose_error.h"
@@ -22,7 +23,7 @@ constexpr char kNotBoxedIn[] = "no free side and not boxed in by seams on all fo
 }  // namespace
 
 std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, BoxFace grasp,
-                              const AcceptanceOptions& o) {
+                              const AcceptanceOptions& o, int out_of_view_side) {
   // The in-plane position must be measured, not guessed: a free side along
   // each of the face's axes.
   const int fi = static_cast<int>(grasp);
@@ -42,6 +43,9 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
     }
     measured += k == SideKind::kFree || k == SideKind::kSeam || k == SideKind::kTiled;
   }
+  // A side out of view that what is in view pins (SideOutOfViewPinned)
+  // counts as measured: the box's size says where the face ends there.
+  measured += out_of_view_side >= 0;
   // At least two sides pin the face down; a face with no free side must be
   // boxed in on all four (by seams or whole tiles of its layer).
   if (measured < 2) return "fewer than two sides of the face measured";
@@ -54,6 +58,7 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
   // turned a quarter). A side with nothing seen near it (a shadow's missing
   // returns) may hide the box's third side as well.
   for (int s = 0; s < 4; ++s) {
+    if (s == out_of_view_side) continue;
     const bool occluded = ref.sides[s] == SideKind::kOccluded;
     const bool unseen = o.check_unseen_sides && ref.sides[s] == SideKind::kUnknown;
     if (!occluded && !unseen) continue;
@@ -70,7 +75,8 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
 }
 
 double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
-                    BoxFace grasp, const AcceptanceOptions& o, std::string* reason) {
+                    BoxFace grasp, const AcceptanceOptions& o, std::string* reason,
+                    int out_of_view_side) {
   auto reject = [&](std::string why) {
     if (reason != nullptr) *reason = std::move(why);
     return -1.0;
@@ -103,7 +109,7 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
     return reject(absl::StrFormat("%.0f%% of the box hidden: sunk into a surface?",
                                   100.0 * ev.total.occluded / ev.total.expected));
   }
-  if (std::string why = RefinementVerdict(ref, dims, grasp, o); !why.empty()) {
+  if (std::string why = RefinementVerdict(ref, dims, grasp, o, out_of_view_side); !why.empty()) {
     return reject(std::move(why));
   }
   return std::clamp(0.5 * grasp_support + 0.5 * ev.support() - 2.0 * ev.see_through_fraction() -
@@ -328,9 +334,10 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   // side may leave the view, that check decides: here its centre and some
   // of each of its sides need only be in view (a neighbour of a box found,
   // out past the image's edge).
+  const AcceptanceOptions& acceptance = options_.acceptance;
   if (!GraspFaceInView(p.camera_T_box, grasp, -20.0) &&
-      !(options_.acceptance.measured_face_may_leave_view &&
-        GraspFaceMeasurable(p.camera_T_box, grasp))) {
+      !(acceptance.measured_face_may_leave_view &&
+        GraspFaceMeasurable(p.camera_T_box, grasp, acceptance.face_may_run_out_of_view ? 3 : 4))) {
     return false;
   }
   *refined = true;
@@ -348,21 +355,24 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
     *reason = kMovedTooFar;
     return false;
   }
+  // A face the border cuts: is it pinned up to the border?
+  const bool in_view = GraspFaceInView(cand.box.camera_T_box, grasp, acceptance.border_margin_px);
+  const int out_of_view = OutOfViewSide(cand.box.camera_T_box, grasp, cand.refinement, in_view);
   // What the refinement alone rejects (most often a side that runs on flat:
   // two thirds of all refined hypotheses) needs no full evidence.
   if (std::string why =
-          RefinementVerdict(cand.refinement, options_.box, grasp, options_.acceptance);
+          RefinementVerdict(cand.refinement, options_.box, grasp, acceptance, out_of_view);
       !why.empty()) {
     *reason = std::move(why);
     return false;
   }
   cand.evidence = MeasureBox(depth_, cand.box.camera_T_box, options_.box, options_.evidence);
-  const double score = JudgeRefined(cand.evidence, cand.refinement, options_.box, grasp,
-                                    options_.acceptance, reason);
+  const double score = JudgeRefined(cand.evidence, cand.refinement, options_.box, grasp, acceptance,
+                                    reason, out_of_view);
   if (score < 0.0) return false;
-  if (!GraspFaceInView(cand.box.camera_T_box, grasp, options_.acceptance.border_margin_px) &&
-      !(options_.acceptance.measured_face_may_leave_view &&
-        PinnedOnEverySide(cand.refinement.sides, options_.acceptance.leaving_view_free_axes))) {
+  if (!in_view && out_of_view < 0 &&
+      !(acceptance.measured_face_may_leave_view &&
+        PinnedOnEverySide(cand.refinement.sides, acceptance.leaving_view_free_axes))) {
     *reason = "grasp face cut by the image border";
     return false;
   }
@@ -374,9 +384,11 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
     Eigen::Isometry3d again = cand.box.camera_T_box;
     const RefinementResult second =
         RefineOnGraspFace(depth_, options_.box, grasp, options_.refinement, &again);
-    std::string why = second.ok
-                          ? RefinementVerdict(second, options_.box, grasp, options_.acceptance)
-                          : std::string(kMovedTooFar);
+    const int again_out_of_view = OutOfViewSide(
+        again, grasp, second, GraspFaceInView(again, grasp, acceptance.border_margin_px));
+    std::string why =
+        second.ok ? RefinementVerdict(second, options_.box, grasp, acceptance, again_out_of_view)
+                  : std::string(kMovedTooFar);
     if (!why.empty()) {
       *reason = "refined once more from where it was refined, " + why;
       return false;
@@ -433,24 +445,40 @@ bool HypothesisJudge::GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace fac
   return true;
 }
 
-bool HypothesisJudge::GraspFaceMeasurable(const Eigen::Isometry3d& pose, BoxFace face) const {
+int HypothesisJudge::OutOfViewSide(const Eigen::Isometry3d& pose, BoxFace grasp,
+                                   const RefinementResult& ref, bool in_view) const {
+  if (in_view || !ref.ok || !options_.acceptance.face_may_run_out_of_view) return -1;
+  return SideOutOfViewPinned(depth_, pose, grasp, options_.box, ref, options_.acceptance,
+                             options_.refinement.plane_tolerance_m);
+}
+
+bool HypothesisJudge::GraspFaceMeasurable(const Eigen::Isometry3d& pose, BoxFace face,
+                                          int sides_in_view) const {
   auto in_view = [&](double sa, double sb) {
     const std::optional<Eigen::Vector2d> px = GraspFacePixel(pose, face, sa, sb);
     return px && depth_.inside(static_cast<int>(std::floor(px->x())),
                                static_cast<int>(std::floor(px->y())));
   };
   if (!in_view(0.0, 0.0)) return false;
+  // With a side out of view, the face's middle fifth on both axes in view:
+  // whichever side the border cuts, 60 % of the face is in view
+  // (AcceptanceOptions::min_in_view_share decides after refinement).
+  if (sides_in_view < 4 &&
+      !(in_view(0.1, 0.0) && in_view(-0.1, 0.0) && in_view(0.0, 0.1) && in_view(0.0, -0.1))) {
+    return false;
+  }
   // Every side needs some of its length in view to be measured, which a
   // face leaving the view must be on all four (PinnedOnEverySide).
+  int sides = 0;
   for (const double s : {-0.5, 0.5}) {
     bool a_side = false, b_side = false;
     for (const double t : {-0.25, 0.0, 0.25}) {
       a_side = a_side || in_view(s, t);
       b_side = b_side || in_view(t, s);
     }
-    if (!a_side || !b_side) return false;
+    sides += a_side + b_side;
   }
-  return true;
+  return sides >= sides_in_view;
 }
 
 int HypothesisJudge::FindLike(const std::vector<Eigen::Isometry3d>& poses,

@@ -29,14 +29,17 @@ struct Candidate {
 
 // The part of the acceptance test the refinement alone decides (the face's
 // measured extents and how its sides end): "" when it passes, else why not.
+// `out_of_view_side`: a side of the face out of view that what is in view
+// pins (SideOutOfViewPinned), counted as measured; -1: none.
 std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, BoxFace grasp,
-                              const AcceptanceOptions& o);
+                              const AcceptanceOptions& o, int out_of_view_side = -1);
 
 // The acceptance test of a refined hypothesis: its score in [0, 1], or < 0
 // when the depth image contradicts it (see AcceptanceOptions); then
 // `reason`, when given, says which test failed.
 double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
-                    BoxFace grasp, const AcceptanceOptions& o, std::string* reason = nullptr);
+                    BoxFace grasp, const AcceptanceOptions& o, std::string* reason = nullptr,
+                    int out_of_view_side = -1);
 
 // The box turned a quarter about its grasp face's normal, flush with the
 // face's corner at (sa, sb) (each +1 or -1 along the face's a and b axes):
@@ -134,9 +137,14 @@ class HypothesisJudge {
   std::optional<Eigen::Vector2d> GraspFacePixel(const Eigen::Isometry3d& pose, BoxFace face,
                                                 double sa, double sb) const;
   bool GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face, double margin) const;
-  // The grasp face's centre in view, and on each side a point (at a
-  // quarter, half or three quarters of it).
-  bool GraspFaceMeasurable(const Eigen::Isometry3d& pose, BoxFace face) const;
+  // The grasp face's centre in view, and on `sides_in_view` of its sides a
+  // point (at a quarter, half or three quarters of it).
+  bool GraspFaceMeasurable(const Eigen::Isometry3d& pose, BoxFace face, int sides_in_view) const;
+  // The side of a refined face not `in_view` that what is in view pins
+  // (SideOutOfViewPinned, with AcceptanceOptions::face_may_run_out_of_view),
+  // or -1.
+  int OutOfViewSide(const Eigen::Isometry3d& pose, BoxFace grasp, const RefinementResult& ref,
+                    bool in_view) const;
   bool Seen(const Eigen::Isometry3d& pose) const;
   // The index in `poses` of one like `pose` (within 1 cm, axes within
   // ~2.5 degrees up to the box's symmetries), or -1.

@@ -1,0 +1,142 @@
+// A grasp face the image border cuts on one side (internal/border_faces.h):
+// pinned when what is in view says which face of the box it is and where
+// it ends; otherwise declined, as every face cut by the border was before.
+#include "common/perception/internal/border_faces.h"
+
+#include <gtest/gtest.h>
+
+#include "common/perception/internal/hypothesis_judge.h"
+#include "common/perception/pose_error.h"
+#include "tests/support/scene_generator.h"
+
+namespace cornerpose::testing {
+namespace {
+
+constexpr BoxDims kCartonS{0.30, 0.20, 0.15};
+constexpr BoxDims kSquareTop{0.30, 0.30, 0.20};
+constexpr double kDistance = 1.1;  // camera to the box's top, metres
+
+// One box lying on the floor, seen straight down (its x axis along the
+// image's u), with the principal point moved so that only `share` of its
+// top's length along x lies in view: its -x side is out past the image's
+// left border. No noise.
+struct CutBox {
+  RenderedScene out;
+  DepthImage depth;
+};
+CutBox RenderCut(const BoxDims& dims, double share) {
+  Scene scene;
+  const double half_px = 0.5 * dims.l * scene.camera.fx / kDistance;
+  // The top's centre projects at u = cx; its left side at cx - half_px.
+  scene.camera.cx = half_px - (1.0 - share) * 2.0 * half_px;
+  scene.world_T_camera = LookAtCamera(Eigen::Vector3d(0.0, 0.0, dims.h), kDistance, 0.0, 0.0, 0.0);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation().z() = dims.h / 2.0;
+  scene.boxes.push_back({dims, pose, true});
+  NoiseOptions noise;
+  noise.enabled = false;
+  CutBox b{Render(scene, noise), {}};
+  b.depth = MakeDepthImage(b.out.cloud, b.out.camera);
+  return b;
+}
+
+// The judge's verdict on the true pose alone: the accepted pose, or none.
+std::optional<Eigen::Isometry3d> Judged(const CutBox& b, const BoxDims& dims, bool may_run_out) {
+  DetectorOptions o;
+  o.box = dims;
+  o.acceptance.face_may_run_out_of_view = may_run_out;
+  const internal::HypothesisJudge judge(b.depth, o);
+  const std::optional<internal::Candidate> c = judge.JudgeAlone(b.out.boxes.at(0).camera_T_box);
+  if (!c) return std::nullopt;
+  return c->box.camera_T_box;
+}
+
+// The refinement's reading of the true pose, and the side it pins.
+int PinnedSide(const CutBox& b, const BoxDims& dims) {
+  DetectorOptions o;
+  o.box = dims;
+  Eigen::Isometry3d pose = b.out.boxes.at(0).camera_T_box;
+  const RefinementResult ref =
+      RefineOnGraspFace(b.depth, dims, BoxFace::kPlusZ, o.refinement, &pose);
+  return internal::SideOutOfViewPinned(b.depth, pose, BoxFace::kPlusZ, dims, ref, o.acceptance,
+                                       o.refinement.plane_tolerance_m);
+}
+
+// Three quarters of a carton's top in view along its 0.30 m side: no other
+// side of the box (0.15 m, its height) is that long, so it is this face,
+// ended where its measured right side and its size say. Found, where it
+// is; declined with the rule off, as before.
+TEST(BorderFacesTest, AFaceThreeQuartersInViewIsPinnedByItsSize) {
+  const CutBox b = RenderCut(kCartonS, 0.75);
+  EXPECT_EQ(PinnedSide(b, kCartonS), 1);  // -a: the box's -x side
+  const std::optional<Eigen::Isometry3d> found = Judged(b, kCartonS, true);
+  ASSERT_TRUE(found.has_value());
+  const PoseError e = ComparePoses(*found, b.out.boxes.at(0).camera_T_box, kCartonS);
+  EXPECT_LT(e.translation_m, 0.01);
+  EXPECT_LT(e.rotation_deg, 2.0);
+  EXPECT_FALSE(Judged(b, kCartonS, false).has_value());
+}
+
+// Less than min_in_view_share in view: where a gripper would aim, the
+// face's centre, is too near the border to trust. Declined.
+TEST(BorderFacesTest, AFaceMostlyOutOfViewIsDeclined) {
+  const CutBox b = RenderCut(kCartonS, 0.5);
+  EXPECT_EQ(PinnedSide(b, kCartonS), -1);
+  EXPECT_FALSE(Judged(b, kCartonS, true).has_value());
+}
+
+// A square top (0.30 x 0.30) with 0.21 m of one side in view could as
+// well be the 0.30 x 0.20 side of the box standing on end: not pinned
+// until more than 0.20 m + the extent tolerance is seen.
+TEST(BorderFacesTest, AFaceAShorterSideOfTheBoxCouldExplainIsNotPinned) {
+  const CutBox short_of_it = RenderCut(kSquareTop, 0.7);
+  EXPECT_EQ(PinnedSide(short_of_it, kSquareTop), -1);
+  EXPECT_FALSE(Judged(short_of_it, kSquareTop, true).has_value());
+  const CutBox past_it = RenderCut(kSquareTop, 0.85);
+  EXPECT_EQ(PinnedSide(past_it, kSquareTop), 1);
+  EXPECT_TRUE(Judged(past_it, kSquareTop, true).has_value());
+}
+
+// The carton's 0.20 x 0.15 end face as the grasp face (+x), its 0.20 m
+// side running out of view: the box's 0.30 m side could go on there, out
+// of view (a carton lying on its side, not standing on end). Never pinned,
+// however much of it is in view; its top (+z) with the same sides is.
+TEST(BorderFacesTest, AFaceALongerSideOfTheBoxCouldContinueIsNotPinned) {
+  const CutBox b = RenderCut(kCartonS, 0.75);
+  DetectorOptions o;
+  o.box = kCartonS;
+  RefinementResult ref;
+  ref.ok = true;
+  ref.sides = {SideKind::kFree, SideKind::kUnknown, SideKind::kFree, SideKind::kFree};
+  ref.free_sides = 3;
+  const Eigen::Isometry3d pose = b.out.boxes.at(0).camera_T_box;
+  EXPECT_EQ(internal::SideOutOfViewPinned(b.depth, pose, BoxFace::kPlusX, kCartonS, ref,
+                                          o.acceptance, o.refinement.plane_tolerance_m),
+            -1);
+  EXPECT_EQ(internal::SideOutOfViewPinned(b.depth, pose, BoxFace::kPlusZ, kCartonS, ref,
+                                          o.acceptance, o.refinement.plane_tolerance_m),
+            1);
+}
+
+// Two sides not measured (a face at a corner of the view, or a side that
+// is hidden as well as one out of view): nothing pins it.
+TEST(BorderFacesTest, AFaceWithTwoSidesUnmeasuredIsNotPinned) {
+  const CutBox b = RenderCut(kCartonS, 0.75);
+  DetectorOptions o;
+  o.box = kCartonS;
+  RefinementResult ref;
+  ref.ok = true;
+  ref.sides = {SideKind::kFree, SideKind::kUnknown, SideKind::kFree, SideKind::kOccluded};
+  ref.free_sides = 2;
+  const Eigen::Isometry3d pose = b.out.boxes.at(0).camera_T_box;
+  EXPECT_EQ(internal::SideOutOfViewPinned(b.depth, pose, BoxFace::kPlusZ, kCartonS, ref,
+                                          o.acceptance, o.refinement.plane_tolerance_m),
+            -1);
+  ref.sides[3] = SideKind::kFree;
+  EXPECT_EQ(internal::SideOutOfViewPinned(b.depth, pose, BoxFace::kPlusZ, kCartonS, ref,
+                                          o.acceptance, o.refinement.plane_tolerance_m),
+            1);
+}
+
+}  // namespace
+}  // namespace cornerpose::testing
