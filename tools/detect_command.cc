@@ -61,6 +61,8 @@ constexpr char kHelp[] =
     "                       of its tiles (true)\n"
     "  --floor_check BOOL   no box reaches through the floor, the farthest large plane\n"
     "                       (true)\n"
+    "  --kept_seams BOOL    a side running on flat is a seam where it lies against a\n"
+    "                       box already found, coplanar and aligned (true)\n"
     "  --level_check M      a box whose top is level with a box beside it but whose\n"
     "                       bottom would lie more than M below that one's is taken\n"
     "                       out (0.05; 0: off)\n"
@@ -179,6 +181,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("border_faces", &options.faces.propose_at_border),
         args.SetInt("leaving_view", &options.acceptance.leaving_view_free_axes),
         args.SetBool("out_of_view", &options.acceptance.face_may_run_out_of_view),
+        args.SetBool("kept_seams", &options.acceptance.kept_box_ends_side),
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("seam_split", &options.faces.seam_split.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
@@ -297,6 +300,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "border_faces",
                                                        "leaving_view",
                                                        "out_of_view",
+                                                       "kept_seams",
                                                        "anchored_faces",
                                                        "seam_split",
                                                        "rim_sides",

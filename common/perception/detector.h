@@ -80,6 +80,13 @@ struct AcceptanceOptions {
   bool face_may_run_out_of_view = true;
   // Share of the cut side's length that must be in view. Unitless, (0, 1].
   double min_in_view_share = 0.6;
+  // A side the refinement finds running on flat (no seam in depth or
+  // colour) is a seam where it lies against the grasp face of a box already
+  // kept, coplanar and aligned with it (internal/kept_neighbours.h): in a
+  // layer of touching boxes the kept box vouches for a seam the sensor does
+  // not show. The box must still be ended on its other sides. False: such a
+  // side declines the box ("a side runs on flat").
+  bool kept_box_ends_side = true;
   // Two accepted boxes may not overlap by more than this (each is shrunk by
   // it before the overlap test). Metres.
   double overlap_margin_m = 0.015;

@@ -9,6 +9,7 @@
 #include "absl/strings/str_format.h"
 #include "common/perception/internal/border_faces.h"
 #include "common/perception/internal/box_overlap.h"
+#include "common/perception/internal/kept_neighbours.h"
 #include "common/perception/internal/parallel.h"
 #include "common/perception/pose_error.h"
 
@@ -194,7 +195,7 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads,
   ParallelForChunks(n, 1, threads, [&](int, int i, int) {
     if (StopRequested(cancel_) || settled[i]) return;
     bool r = false;
-    accepted[i] = EvaluateOne(queue_[i], &results[i], &r, &reasons[i]);
+    accepted[i] = EvaluateOne(queue_[i], kept, &results[i], &r, &reasons[i]);
     refined[i] = r;
   });
   std::vector<Candidate> out;
@@ -305,14 +306,14 @@ std::optional<Candidate> HypothesisJudge::JudgeAlone(const Eigen::Isometry3d& ca
   Candidate c;
   bool refined = false;
   std::string reason;
-  if (!EvaluateOne(Proposal{camera_T_box, 0, {}, false}, &c, &refined, &reason)) {
+  if (!EvaluateOne(Proposal{camera_T_box, 0, {}, false}, {}, &c, &refined, &reason)) {
     return std::nullopt;
   }
   return c;
 }
 
-bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refined,
-                                  std::string* reason) const {
+bool HypothesisJudge::EvaluateOne(const Proposal& p, const std::vector<DetectedBox>& kept,
+                                  Candidate* out, bool* refined, std::string* reason) const {
   Candidate& cand = *out;
   cand.box.camera_T_box = p.camera_T_box;
   cand.box.num_corners = p.corners;
@@ -355,6 +356,7 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
     *reason = kMovedTooFar;
     return false;
   }
+  SeamsAgainstKept(cand.box.camera_T_box, grasp, kept, &cand.refinement);
   // A face the border cuts: is it pinned up to the border?
   const bool in_view = GraspFaceInView(cand.box.camera_T_box, grasp, acceptance.border_margin_px);
   const int out_of_view = OutOfViewSide(cand.box.camera_T_box, grasp, cand.refinement, in_view);
@@ -382,8 +384,9 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, Candidate* out, bool* refin
   cand.chained = p.past_declined > 0 || p.chained;
   if (cand.chained) {
     Eigen::Isometry3d again = cand.box.camera_T_box;
-    const RefinementResult second =
+    RefinementResult second =
         RefineOnGraspFace(depth_, options_.box, grasp, options_.refinement, &again);
+    SeamsAgainstKept(again, grasp, kept, &second);
     const int again_out_of_view = OutOfViewSide(
         again, grasp, second, GraspFaceInView(again, grasp, acceptance.border_margin_px));
     std::string why =
@@ -443,6 +446,18 @@ bool HypothesisJudge::GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace fac
     }
   }
   return true;
+}
+
+void HypothesisJudge::SeamsAgainstKept(const Eigen::Isometry3d& pose, BoxFace grasp,
+                                       const std::vector<DetectedBox>& kept,
+                                       RefinementResult* ref) const {
+  if (!options_.acceptance.kept_box_ends_side || kept.empty() || !ref->ok) return;
+  for (int s = 0; s < 4; ++s) {
+    if (ref->sides[s] == SideKind::kContinues &&
+        SideAgainstKeptBox(pose, grasp, options_.box, s, kept)) {
+      ref->sides[s] = SideKind::kSeam;
+    }
+  }
 }
 
 int HypothesisJudge::OutOfViewSide(const Eigen::Isometry3d& pose, BoxFace grasp,

@@ -131,7 +131,13 @@ class HypothesisJudge {
   // Evaluates one proposal; false when rejected. `refined` is set when it
   // got as far as refinement; then `reason` says why it was rejected, and
   // out->box holds the refined pose and out->box.score its first support.
-  bool EvaluateOne(const Proposal& p, Candidate* out, bool* refined, std::string* reason) const;
+  // `kept`: the boxes kept so far (SeamsAgainstKept).
+  bool EvaluateOne(const Proposal& p, const std::vector<DetectedBox>& kept, Candidate* out,
+                   bool* refined, std::string* reason) const;
+  // A side the refinement found running on flat that lies against a box of
+  // `kept` (SideAgainstKeptBox) is a seam: the kept box vouches for it.
+  void SeamsAgainstKept(const Eigen::Isometry3d& pose, BoxFace grasp,
+                        const std::vector<DetectedBox>& kept, RefinementResult* ref) const;
   // The pixel of a point of the grasp face (sa, sb in [-0.5, 0.5] along its
   // two axes), or nothing behind the camera.
   std::optional<Eigen::Vector2d> GraspFacePixel(const Eigen::Isometry3d& pose, BoxFace face,
