@@ -63,6 +63,9 @@ constexpr char kHelp[] =
     "                       (true)\n"
     "  --kept_seams BOOL    a side running on flat is a seam where it lies against a\n"
     "                       box already found, coplanar and aligned (true)\n"
+    "  --pairs BOOL         two boxes declined only for one side running on flat, those\n"
+    "                       sides against each other, end each other when both pass\n"
+    "                       so and their outline tiles one way with two faces (true)\n"
     "  --level_check M      a box whose top is level with a box beside it but whose\n"
     "                       bottom would lie more than M below that one's is taken\n"
     "                       out (0.05; 0: off)\n"
@@ -182,6 +185,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetInt("leaving_view", &options.acceptance.leaving_view_free_axes),
         args.SetBool("out_of_view", &options.acceptance.face_may_run_out_of_view),
         args.SetBool("kept_seams", &options.acceptance.kept_box_ends_side),
+        args.SetBool("pairs", &options.acceptance.pairs_end_each_other),
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("seam_split", &options.faces.seam_split.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
@@ -301,6 +305,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "leaving_view",
                                                        "out_of_view",
                                                        "kept_seams",
+                                                       "pairs",
                                                        "anchored_faces",
                                                        "seam_split",
                                                        "rim_sides",

@@ -73,6 +73,9 @@ BoxFace JudgeOne(const DepthImage& depth, const DetectorOptions& options,
               ref.ok ? "ok" : "FAILED", 1000.0 * moved.norm(), turned, SideName(ref.sides[0]),
               SideName(ref.sides[1]), SideName(ref.sides[2]), SideName(ref.sides[3]),
               1000.0 * ref.plane_rms_m);
+  for (int side = 0; side < 4; ++side) {
+    if (ref.past_gap[side]) std::printf(", plane past a gap beyond side %d", side);
+  }
   // A side out of view that what is in view pins (internal/border_faces.h).
   const int out_of_view =
       options.acceptance.face_may_run_out_of_view

@@ -18,6 +18,7 @@
 #include "common/perception/camera_model.h"
 #include "common/perception/internal/box_overlap.h"
 #include "common/perception/internal/hypothesis_judge.h"
+#include "common/perception/internal/kept_neighbours.h"
 #include "common/perception/internal/parallel.h"
 #include "common/perception/neighbour_hypotheses.h"
 #include "common/validation/range_check.h"
@@ -705,16 +706,7 @@ class BoxAcceptance {
                          return a.box.score > b.box.score;
                        });
       for (internal::Candidate& c : pending) {
-        if (OverlapsKept(c.box.camera_T_box)) continue;
-        det_->boxes.push_back(c.box);
-        readings_.push_back({c.refinement.sides, c.refinement.past_gap});
-        if (options_.propagate_to_neighbours) {
-          for (const Eigen::Isometry3d& pose :
-               NeighbourHypotheses(c.box, options_.box, options_.neighbour_gap_m,
-                                   options_.neighbours_a_layer_down)) {
-            judge_->ProposeNeighbour(pose, c.chained);
-          }
-        }
+        if (!OverlapsKept(c.box.camera_T_box)) Keep(c);
       }
       // A declined neighbour's neighbours (DetectorOptions::
       // neighbour_steps_past_declined): the chain goes on past a seam missed.
@@ -729,10 +721,117 @@ class BoxAcceptance {
     }
   }
 
+  // Pairs that end each other (AcceptPairs), each with what it proposes,
+  // until no pair is left: after every other hypothesis (two boxes that
+  // vouch for each other are less sure than one its own sides end).
+  void AcceptPairsAndTheirs() {
+    while (!cancel_.Stopped() && AcceptPairs()) AcceptAll();
+  }
+
   // The readings of each det->boxes entry, for the plausibility checks.
   std::vector<KeptReading>* readings() { return &readings_; }
 
  private:
+  // Keeps an accepted candidate; it proposes its neighbours.
+  void Keep(const internal::Candidate& c) {
+    det_->boxes.push_back(c.box);
+    readings_.push_back({c.refinement.sides, c.refinement.past_gap});
+    if (options_.propagate_to_neighbours) {
+      for (const Eigen::Isometry3d& pose : NeighbourHypotheses(
+               c.box, options_.box, options_.neighbour_gap_m, options_.neighbours_a_layer_down)) {
+        judge_->ProposeNeighbour(pose, c.chained);
+      }
+    }
+  }
+
+  // A declined candidate as a kept box would be (its grasp face's centre
+  // and normal set), for SideAgainstKeptBox.
+  DetectedBox AsKept(const internal::Candidate& c) const {
+    DetectedBox b = c.box;
+    const Eigen::Vector3d n = BoxFaceNormal(b.grasp_face);
+    const int axis = static_cast<int>(b.grasp_face) / 2;
+    b.grasp_normal_camera = b.camera_T_box.linear() * n;
+    b.grasp_centre_camera = b.camera_T_box * (n * options_.box[axis] / 2.0);
+    return b;
+  }
+
+  // True when the outline of the two faces together (a's face and b's,
+  // side by side across a's side `side_a`) tiles with two faces of the box
+  // or fewer one way only (TilingsOf; a finer tiling needs more seams the
+  // depth does not show, as the face tiles' fewest-tiles rule has it): two
+  // bricks side by side along their short sides make a square that tiles
+  // as well with the two turned a quarter, and nothing in the depth says
+  // which.
+  bool PairTilesOneWay(const internal::Candidate& a, int side_a,
+                       const internal::Candidate& b) const {
+    const int n = static_cast<int>(a.box.grasp_face) / 2;
+    const int here = side_a < 2 ? (n + 1) % 3 : (n + 2) % 3;
+    const int other = side_a < 2 ? (n + 2) % 3 : (n + 1) % 3;
+    const Eigen::Vector3d axis = a.box.camera_T_box.linear().col(here);
+    const double span =
+        std::abs((b.box.camera_T_box.translation() - a.box.camera_T_box.translation()).dot(axis)) +
+        options_.box[here];
+    const std::vector<FaceTiling> tilings =
+        TilingsOf(span, options_.box[other], options_.box, options_.faces);
+    return std::count_if(tilings.begin(), tilings.end(),
+                         [](const FaceTiling& t) { return t.tiles() <= 2; }) == 1;
+  }
+
+  // A side of the candidate's face ends in a seam or a whole tile: it lies
+  // in a layer of touching boxes. A pair ended by free sides all round is
+  // one flat thing twice the box's size as much as two boxes (a deck
+  // board between a pallet's edge and the layer standing on it).
+  static bool Seamed(const internal::Candidate& c) {
+    const auto& sides = c.refinement.sides;
+    return std::any_of(sides.begin(), sides.end(),
+                       [](SideKind k) { return k == SideKind::kSeam || k == SideKind::kTiled; });
+  }
+
+  // Hypotheses declined only for one side on flat whose flat sides lie
+  // against each other's face (AcceptanceOptions::pairs_end_each_other):
+  // each judged again with the other taken as kept; both kept when both
+  // pass. True when a pair was kept.
+  bool AcceptPairs() {
+    std::vector<internal::Candidate> singles = judge_->TakeOneSideOnFlat();
+    std::erase_if(singles,
+                  [&](const internal::Candidate& c) { return OverlapsKept(c.box.camera_T_box); });
+    auto flat_side = [](const internal::Candidate& c) {
+      const auto& sides = c.refinement.sides;
+      return static_cast<int>(std::find(sides.begin(), sides.end(), SideKind::kContinues) -
+                              sides.begin());
+    };
+    bool any = false;
+    for (size_t i = 0; i < singles.size(); ++i) {
+      for (size_t j = i + 1; j < singles.size(); ++j) {
+        const internal::Candidate &a = singles[i], &b = singles[j];
+        if (OverlapsKept(a.box.camera_T_box) || OverlapsKept(b.box.camera_T_box)) continue;
+        const DetectedBox ka = AsKept(a), kb = AsKept(b);
+        if (!internal::SideAgainstKeptBox(a.box.camera_T_box, a.box.grasp_face, options_.box,
+                                          flat_side(a), {kb}) ||
+            !internal::SideAgainstKeptBox(b.box.camera_T_box, b.box.grasp_face, options_.box,
+                                          flat_side(b), {ka})) {
+          continue;
+        }
+        if (!PairTilesOneWay(a, flat_side(a), b) || !(Seamed(a) || Seamed(b))) continue;
+        std::vector<DetectedBox> with = det_->boxes;
+        with.push_back(kb);
+        const std::optional<internal::Candidate> ja = judge_->JudgeAlone(a.box.camera_T_box, with);
+        if (!ja) continue;
+        with.back() = ka;
+        const std::optional<internal::Candidate> jb = judge_->JudgeAlone(b.box.camera_T_box, with);
+        if (!jb || OverlapsKept(ja->box.camera_T_box) || OverlapsKept(jb->box.camera_T_box) ||
+            internal::BoxesOverlap(ja->box.camera_T_box, jb->box.camera_T_box, options_.box,
+                                   options_.acceptance.overlap_margin_m)) {
+          continue;
+        }
+        Keep(*ja);
+        Keep(*jb);
+        any = true;
+      }
+    }
+    return any;
+  }
+
   const DetectorOptions& options_;
   const CancelToken& cancel_;
   internal::HypothesisJudge* const judge_;
@@ -758,6 +857,7 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
         MeasureBox(f.depth, d.camera_T_box, options.box, options.evidence).support();
   }
   acceptance->AcceptAll();
+  acceptance->AcceptPairsAndTheirs();
   const std::optional<FloorPlane> floor =
       options.floor_check ? FindFloor(f.depth, options, faces) : std::nullopt;
   std::vector<Eigen::Isometry3d> cleared;  // CheckTurnedReadings

@@ -87,6 +87,13 @@ struct AcceptanceOptions {
   // not show. The box must still be ended on its other sides. False: such a
   // side declines the box ("a side runs on flat").
   bool kept_box_ends_side = true;
+  // Two hypotheses declined only for one side running on flat, every other
+  // side ended, whose flat sides lie against each other's grasp face
+  // (coplanar and aligned, as kept_box_ends_side asks) end each other: both
+  // are judged again, each with the other taken as kept, and returned when
+  // both pass. Two touching boxes whose shared seam shows nothing, every
+  // other side of both ended. False: both declined.
+  bool pairs_end_each_other = true;
   // Two accepted boxes may not overlap by more than this (each is shrunk by
   // it before the overlap test). Metres.
   double overlap_margin_m = 0.015;

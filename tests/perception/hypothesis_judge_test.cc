@@ -373,5 +373,21 @@ TEST(RefinementVerdictTest, AnUnseenSideWhereALongerSideCouldStandIsDeclined) {
   EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusZ, o), "");
 }
 
+// A pair may end each other (AcceptanceOptions::pairs_end_each_other) only
+// when each runs on flat on one side and is ended on the three others.
+TEST(OneSideOnFlatTest, OneSideOnFlatAndTheOthersEnded) {
+  RefinementResult ref;
+  ref.sides = {SideKind::kContinues, SideKind::kFree, SideKind::kSeam, SideKind::kTiled};
+  EXPECT_TRUE(internal::OneSideOnFlat(ref));
+  ref.sides[1] = SideKind::kContinues;
+  EXPECT_FALSE(internal::OneSideOnFlat(ref));  // two on flat
+  ref.sides[1] = SideKind::kUnknown;
+  EXPECT_FALSE(internal::OneSideOnFlat(ref));  // one not ended
+  ref.sides[1] = SideKind::kOccluded;
+  EXPECT_FALSE(internal::OneSideOnFlat(ref));
+  ref.sides = {SideKind::kFree, SideKind::kFree, SideKind::kSeam, SideKind::kSeam};
+  EXPECT_FALSE(internal::OneSideOnFlat(ref));  // none on flat
+}
+
 }  // namespace
 }  // namespace cornerpose::testing

@@ -118,6 +118,18 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
                     0.0, 1.0);
 }
 
+bool OneSideOnFlat(const RefinementResult& ref) {
+  int on_flat = 0;
+  for (SideKind k : ref.sides) {
+    if (k == SideKind::kContinues) {
+      ++on_flat;
+    } else if (k != SideKind::kFree && k != SideKind::kSeam && k != SideKind::kTiled) {
+      return false;
+    }
+  }
+  return on_flat == 1;
+}
+
 namespace {
 
 // Every side of the grasp face measured where the face ends (free or a
@@ -234,6 +246,10 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads,
           q.past_declined < options_.neighbour_steps_past_declined) {
         stepping_stones_.push_back({results[i].box, q.past_declined + 1});
       }
+      if (refined[i] && reasons[i] == kRunsOnFlat && options_.acceptance.pairs_end_each_other &&
+          OneSideOnFlat(results[i].refinement)) {
+        one_side_on_flat_.push_back(results[i]);
+      }
       if (refined[i]) {
         declined_.push_back(
             {results[i].box.camera_T_box, results[i].box.score, std::move(reasons[i])});
@@ -302,11 +318,12 @@ std::vector<Eigen::Isometry3d> TurnedAtMeasuredCorners(const Eigen::Isometry3d& 
   return out;
 }
 
-std::optional<Candidate> HypothesisJudge::JudgeAlone(const Eigen::Isometry3d& camera_T_box) const {
+std::optional<Candidate> HypothesisJudge::JudgeAlone(const Eigen::Isometry3d& camera_T_box,
+                                                     const std::vector<DetectedBox>& kept) const {
   Candidate c;
   bool refined = false;
   std::string reason;
-  if (!EvaluateOne(Proposal{camera_T_box, 0, {}, false}, {}, &c, &refined, &reason)) {
+  if (!EvaluateOne(Proposal{camera_T_box, 0, {}, false}, kept, &c, &refined, &reason)) {
     return std::nullopt;
   }
   return c;

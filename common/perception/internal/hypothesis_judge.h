@@ -34,6 +34,10 @@ struct Candidate {
 std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, BoxFace grasp,
                               const AcceptanceOptions& o, int out_of_view_side = -1);
 
+// True when exactly one side of the face runs on flat (kContinues) and the
+// other three end it (free, a seam or tiled).
+bool OneSideOnFlat(const RefinementResult& ref);
+
 // The acceptance test of a refined hypothesis: its score in [0, 1], or < 0
 // when the depth image contradicts it (see AcceptanceOptions); then
 // `reason`, when given, says which test failed.
@@ -88,8 +92,15 @@ class HypothesisJudge {
   // settled_overlap_margin_m) are not judged, and may be proposed again.
   std::vector<Candidate> Evaluate(int threads, const std::vector<DetectedBox>& kept = {});
   // Judges one pose now, outside the queue: no duplicate is dropped and
-  // nothing is recorded. The accepted candidate, or nothing.
-  std::optional<Candidate> JudgeAlone(const Eigen::Isometry3d& camera_T_box) const;
+  // nothing is recorded. The accepted candidate, or nothing. `kept`: boxes
+  // taken as kept (a side against one is a seam: SeamsAgainstKept).
+  std::optional<Candidate> JudgeAlone(const Eigen::Isometry3d& camera_T_box,
+                                      const std::vector<DetectedBox>& kept = {}) const;
+  // The hypotheses refined and declined since the last call only for one
+  // side that runs on flat, every other side ended (OneSideOnFlat;
+  // AcceptanceOptions::pairs_end_each_other): two of them that run on flat
+  // into each other may end each other.
+  std::vector<Candidate> TakeOneSideOnFlat() { return std::exchange(one_side_on_flat_, {}); }
 
   // A neighbour declined only because a side of its face runs on flat,
   // with a seam on another side: what it would have proposed as
@@ -170,6 +181,7 @@ class HypothesisJudge {
   HypothesisStats stats_;
   std::vector<DeclinedCandidate> declined_;
   std::vector<SteppingStone> stepping_stones_;
+  std::vector<Candidate> one_side_on_flat_;
 };
 
 }  // namespace cornerpose::internal
