@@ -63,6 +63,9 @@ constexpr char kHelp[] =
     "                       (true)\n"
     "  --kept_seams BOOL    a side running on flat is a seam where it lies against a\n"
     "                       box already found, coplanar and aligned (true)\n"
+    "  --empty_window N     a frame where nothing is found is detected once more with\n"
+    "                       the planar patches' normal window N cells wide each way of\n"
+    "                       its centre (4; 0: never)\n"
     "  --pairs BOOL         two boxes declined only for one side running on flat, those\n"
     "                       sides against each other, end each other when both pass\n"
     "                       so and their outline tiles one way with two faces (true)\n"
@@ -186,6 +189,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("out_of_view", &options.acceptance.face_may_run_out_of_view),
         args.SetBool("kept_seams", &options.acceptance.kept_box_ends_side),
         args.SetBool("pairs", &options.acceptance.pairs_end_each_other),
+        args.SetInt("empty_window", &options.empty_frame_window_cells),
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("seam_split", &options.faces.seam_split.enabled),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
@@ -306,6 +310,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "out_of_view",
                                                        "kept_seams",
                                                        "pairs",
+                                                       "empty_window",
                                                        "anchored_faces",
                                                        "seam_split",
                                                        "rim_sides",

@@ -440,6 +440,10 @@ absl::Status DetectorOptions::Validate() const {
                          acceptance.Validate(), faces.Validate(), layer_plane.Validate()}) {
     if (!s.ok()) return s;
   }
+  if (empty_frame_window_cells < 0 || empty_frame_window_cells > 8) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("empty_frame_window_cells=", empty_frame_window_cells, " is outside [0, 8]"));
+  }
   if (!(floor_tolerance_m > 0.0 && floor_tolerance_m <= 0.5)) {
     return absl::InvalidArgumentError(
         absl::StrCat("floor_tolerance_m=", floor_tolerance_m, " is outside (0, 0.5]"));
@@ -890,8 +894,12 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
 
 }  // namespace
 
-absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOptions& options_in,
-                                      const CancelToken& cancel) {
+namespace {
+
+// One detection with these options (DetectBoxes: with a wider normal
+// window again where it finds nothing).
+absl::StatusOr<Detection> DetectOnce(const PointCloud& input, const DetectorOptions& options_in,
+                                     const CancelToken& cancel) {
   const Clock::time_point t_start = Clock::now();
   PreparedFrame frame;
   if (absl::Status s = PrepareFrame(input, options_in, &frame); !s.ok()) return s;
@@ -929,6 +937,26 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
   det.timings.poses_ms = MsSince(t0);
   det.timings.total_ms = MsSince(t_start);
   return det;
+}
+
+}  // namespace
+
+absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOptions& options,
+                                      const CancelToken& cancel) {
+  absl::StatusOr<Detection> det = DetectOnce(input, options, cancel);
+  const DetectorOptions defaults;
+  if (!det.ok() || !det->boxes.empty() || options.empty_frame_window_cells == 0 ||
+      !options.face_proposals ||
+      options.faces.patches.window_cells != defaults.faces.patches.window_cells ||
+      det->edge_points.empty()) {
+    return det;
+  }
+  DetectorOptions wider = options;
+  wider.faces.patches.window_cells = options.empty_frame_window_cells;
+  absl::StatusOr<Detection> again = DetectOnce(input, wider, cancel);
+  if (!again.ok()) return again.status();
+  again->timings.total_ms += det->timings.total_ms;
+  return again;
 }
 
 }  // namespace cornerpose
