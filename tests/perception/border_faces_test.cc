@@ -97,45 +97,42 @@ TEST(BorderFacesTest, AFaceAShorterSideOfTheBoxCouldExplainIsNotPinned) {
   EXPECT_TRUE(Judged(past_it, kSquareTop, true).has_value());
 }
 
+// The side SideOutOfViewPinned pins for the true pose of `b`, read with
+// `grasp` as its grasp face and the refinement's reading `sides`.
+int PinnedWithSides(const CutBox& b, BoxFace grasp, const std::array<SideKind, 4>& sides) {
+  DetectorOptions o;
+  o.box = kCartonS;
+  RefinementResult ref;
+  ref.ok = true;
+  ref.sides = sides;
+  return internal::SideOutOfViewPinned(b.depth, b.out.boxes.at(0).camera_T_box, grasp, kCartonS,
+                                       ref, o.acceptance, o.refinement.plane_tolerance_m);
+}
+
 // The carton's 0.20 x 0.15 end face as the grasp face (+x), its 0.20 m
 // side running out of view: the box's 0.30 m side could go on there, out
 // of view (a carton lying on its side, not standing on end). Never pinned,
 // however much of it is in view; its top (+z) with the same sides is.
 TEST(BorderFacesTest, AFaceALongerSideOfTheBoxCouldContinueIsNotPinned) {
   const CutBox b = RenderCut(kCartonS, 0.75);
-  DetectorOptions o;
-  o.box = kCartonS;
-  RefinementResult ref;
-  ref.ok = true;
-  ref.sides = {SideKind::kFree, SideKind::kUnknown, SideKind::kFree, SideKind::kFree};
-  ref.free_sides = 3;
-  const Eigen::Isometry3d pose = b.out.boxes.at(0).camera_T_box;
-  EXPECT_EQ(internal::SideOutOfViewPinned(b.depth, pose, BoxFace::kPlusX, kCartonS, ref,
-                                          o.acceptance, o.refinement.plane_tolerance_m),
-            -1);
-  EXPECT_EQ(internal::SideOutOfViewPinned(b.depth, pose, BoxFace::kPlusZ, kCartonS, ref,
-                                          o.acceptance, o.refinement.plane_tolerance_m),
-            1);
+  const std::array<SideKind, 4> sides{SideKind::kFree, SideKind::kUnknown, SideKind::kFree,
+                                      SideKind::kFree};
+  EXPECT_EQ(PinnedWithSides(b, BoxFace::kPlusX, sides), -1);
+  EXPECT_EQ(PinnedWithSides(b, BoxFace::kPlusZ, sides), 1);
 }
 
 // Two sides not measured (a face at a corner of the view, or a side that
 // is hidden as well as one out of view): nothing pins it.
 TEST(BorderFacesTest, AFaceWithTwoSidesUnmeasuredIsNotPinned) {
   const CutBox b = RenderCut(kCartonS, 0.75);
-  DetectorOptions o;
-  o.box = kCartonS;
-  RefinementResult ref;
-  ref.ok = true;
-  ref.sides = {SideKind::kFree, SideKind::kUnknown, SideKind::kFree, SideKind::kOccluded};
-  ref.free_sides = 2;
-  const Eigen::Isometry3d pose = b.out.boxes.at(0).camera_T_box;
-  EXPECT_EQ(internal::SideOutOfViewPinned(b.depth, pose, BoxFace::kPlusZ, kCartonS, ref,
-                                          o.acceptance, o.refinement.plane_tolerance_m),
-            -1);
-  ref.sides[3] = SideKind::kFree;
-  EXPECT_EQ(internal::SideOutOfViewPinned(b.depth, pose, BoxFace::kPlusZ, kCartonS, ref,
-                                          o.acceptance, o.refinement.plane_tolerance_m),
-            1);
+  EXPECT_EQ(
+      PinnedWithSides(b, BoxFace::kPlusZ,
+                      {SideKind::kFree, SideKind::kUnknown, SideKind::kFree, SideKind::kOccluded}),
+      -1);
+  EXPECT_EQ(
+      PinnedWithSides(b, BoxFace::kPlusZ,
+                      {SideKind::kFree, SideKind::kUnknown, SideKind::kFree, SideKind::kFree}),
+      1);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <random>
 #include <string>
@@ -45,6 +46,25 @@ int WrongBoxes(const Detection& det, const RenderedScene& r) {
     wrong += nearest.translation_m > 0.02 || nearest.rotation_deg > 10.0;
   }
   return wrong;
+}
+
+// The frame's detections with a rule off and on ({off, on}; `set_rule`
+// sets it in the options), each checked for wrong boxes.
+std::array<Detection, 2> DetectedWithRuleOffAndOn(
+    const PointCloud& cloud, const RenderedScene& r, const BoxDims& dims,
+    const std::function<void(bool on, DetectorOptions*)>& set_rule) {
+  std::array<Detection, 2> out;
+  for (const bool on : {false, true}) {
+    DetectorOptions options;
+    options.box = dims;
+    set_rule(on, &options);
+    absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
+    EXPECT_TRUE(det.ok()) << det.status();
+    if (!det.ok()) continue;
+    EXPECT_EQ(WrongBoxes(*det, r), 0) << (on ? "rule on" : "rule off");
+    out[on] = *std::move(det);
+  }
+  return out;
 }
 
 // Frame `i` of one of scripts/evaluate's generated Kinect sets
@@ -828,17 +848,14 @@ TEST(RegressionTest, PalletCartonsTheBorderCutsArePinnedByWhatIsInView) {
   ASSERT_TRUE(frame.ok()) << frame.status();
   const RenderedScene& r = *frame;
   const PointCloud cloud = RoundedToMillimetres(r);
+  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
+      cloud, r, carton_l,
+      [](bool on, DetectorOptions* o) { o->acceptance.face_may_run_out_of_view = on; });
   std::array<int, 2> cut{0, 0};  // rule off, on
-  for (const bool rule : {true, false}) {
-    DetectorOptions options;
-    options.box = carton_l;
-    options.acceptance.face_may_run_out_of_view = rule;
-    const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
-    ASSERT_TRUE(det.ok()) << det.status();
-    EXPECT_EQ(WrongBoxes(*det, r), 0) << rule;
-    for (const DetectedBox& b : det->boxes) cut[rule] += CutByBorder(r, carton_l, b);
-    if (rule) EXPECT_GE(det->boxes.size(), 8u);
+  for (const bool on : {false, true}) {
+    for (const DetectedBox& b : det[on].boxes) cut[on] += CutByBorder(r, carton_l, b);
   }
+  EXPECT_GE(det[1].boxes.size(), 8u);
   // Off, only a carton ended on every side (PinnedOnEverySide) may leave
   // the view.
   EXPECT_GE(cut[1], cut[0] + 3);
@@ -858,18 +875,11 @@ TEST(RegressionTest, ACartonBesideOneFoundIsEndedByItWhereNoSeamShows) {
   ASSERT_TRUE(frame.ok()) << frame.status();
   const RenderedScene& r = *frame;
   const PointCloud cloud = RoundedToMillimetres(r);
-  std::array<size_t, 2> found{0, 0};  // rule off, on
-  for (const bool rule : {true, false}) {
-    DetectorOptions options;
-    options.box = carton_l;
-    options.acceptance.kept_box_ends_side = rule;
-    const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
-    ASSERT_TRUE(det.ok()) << det.status();
-    EXPECT_EQ(WrongBoxes(*det, r), 0) << rule;
-    found[rule] = det->boxes.size();
-  }
-  EXPECT_GE(found[1], 4u);
-  EXPECT_GT(found[1], found[0]);
+  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
+      cloud, r, carton_l,
+      [](bool on, DetectorOptions* o) { o->acceptance.kept_box_ends_side = on; });
+  EXPECT_GE(det[1].boxes.size(), 4u);
+  EXPECT_GT(det[1].boxes.size(), det[0].boxes.size());
 }
 
 // Was: on a Kinect pallet layer of carton_l, two cartons side by side whose
@@ -888,17 +898,10 @@ TEST(RegressionTest, TwoCartonsWhoseSharedSeamShowsNothingEndEachOther) {
   ASSERT_TRUE(frame.ok()) << frame.status();
   const RenderedScene& r = *frame;
   const PointCloud cloud = RoundedToMillimetres(r);
-  std::array<size_t, 2> found{0, 0};  // rule off, on
-  for (const bool rule : {true, false}) {
-    DetectorOptions options;
-    options.box = carton_l;
-    options.acceptance.pairs_end_each_other = rule;
-    const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
-    ASSERT_TRUE(det.ok()) << det.status();
-    EXPECT_EQ(WrongBoxes(*det, r), 0) << rule;
-    found[rule] = det->boxes.size();
-  }
-  EXPECT_GE(found[1], found[0] + 2);
+  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
+      cloud, r, carton_l,
+      [](bool on, DetectorOptions* o) { o->acceptance.pairs_end_each_other = on; });
+  EXPECT_GE(det[1].boxes.size(), det[0].boxes.size() + 2);
 }
 
 // Two bricks side by side along their 9 cm sides make a 0.19 x 0.19 m
@@ -935,20 +938,11 @@ TEST(RegressionTest, AFarStereoPalletThatReturnedNothingIsDetectedWithAWiderWind
       SensorFrame(SensorKind::kStereo, true, "pallet", carton_s, 8, 106008);
   ASSERT_TRUE(frame.ok()) << frame.status();
   const RenderedScene& r = *frame;
-  PointCloud cloud = RoundedToMillimetres(r);
-  for (const int window : {4, 0}) {
-    DetectorOptions options;
-    options.box = carton_s;
-    options.empty_frame_window_cells = window;
-    const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
-    ASSERT_TRUE(det.ok()) << det.status();
-    EXPECT_EQ(WrongBoxes(*det, r), 0) << window;
-    if (window > 0) {
-      EXPECT_GE(det->boxes.size(), 10u);
-    } else {
-      EXPECT_TRUE(det->boxes.empty());
-    }
-  }
+  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
+      RoundedToMillimetres(r), r, carton_s,
+      [](bool on, DetectorOptions* o) { o->empty_frame_window_cells = on ? 4 : 0; });
+  EXPECT_TRUE(det[0].boxes.empty());
+  EXPECT_GE(det[1].boxes.size(), 10u);
 }
 
 }  // namespace
