@@ -142,7 +142,8 @@ TEST(RegressionTest, NoisyRectangleSidesAreNotSplit) {
     std::mt19937 rng(seed);
     std::vector<Eigen::Vector3f> pts;
     for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d a = corners[k], b = corners[(k + 1) % 4];
+      const Eigen::Vector3d& a = corners[k];
+      const Eigen::Vector3d& b = corners[(k + 1) % 4];
       const Eigen::Vector3d d = (b - a).normalized();
       const Eigen::Vector3d u = d.unitOrthogonal(), v = d.cross(u);
       std::uniform_real_distribution<double> along(0.0, (b - a).norm());
