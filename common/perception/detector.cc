@@ -896,10 +896,36 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
 
 namespace {
 
-// One detection with these options (DetectBoxes: with a wider normal
-// window again where it finds nothing).
-absl::StatusOr<Detection> DetectOnce(const PointCloud& input, const DetectorOptions& options_in,
-                                     const CancelToken& cancel) {
+// Phases 3 to 5 on a frame's corners and face proposals: the boxes judged
+// and kept, into det (its boxes, hypotheses, declined candidates and
+// poses_ms).
+absl::Status JudgeAndKeep(const PreparedFrame& frame, const SegmentGroups& groups,
+                          const FaceProposals& faces, const CancelToken& cancel, Detection* det) {
+  const DetectorOptions& options = frame.options;
+  const Clock::time_point t0 = Clock::now();
+  internal::HypothesisJudge judge(frame.depth, options, &cancel);
+  BoxAcceptance acceptance(options, cancel, &judge, det);
+  ProposeFromCorners(*det, groups, options, &judge);
+  acceptance.AcceptAll();
+  std::vector<DeclinedCandidate> declined;
+  if (options.face_proposals) {
+    AcceptFaceTilesAndCheck(frame, faces, &judge, &acceptance, det, &declined);
+  }
+  AlignToLayerPlanes(frame.depth, options.box, options.layer_plane, &det->boxes);
+  if (absl::Status s = cancel.Check("the judging of hypotheses"); !s.ok()) return s;
+  std::stable_sort(det->boxes.begin(), det->boxes.end(),
+                   [](const DetectedBox& a, const DetectedBox& b) { return a.score > b.score; });
+  det->hypotheses = judge.stats();
+  declined.insert(declined.end(), judge.declined().begin(), judge.declined().end());
+  det->declined = StrongestDeclined(std::move(declined), det->boxes, options);
+  det->timings.poses_ms += MsSince(t0);
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOptions& options_in,
+                                      const CancelToken& cancel) {
   const Clock::time_point t_start = Clock::now();
   PreparedFrame frame;
   if (absl::Status s = PrepareFrame(input, options_in, &frame); !s.ok()) return s;
@@ -917,46 +943,27 @@ absl::StatusOr<Detection> DetectOnce(const PointCloud& input, const DetectorOpti
   if (absl::Status s = FindEdgesAndFaces(frame, cancel, &det, &groups, &faces); !s.ok()) {
     return s;
   }
+  if (absl::Status s = JudgeAndKeep(frame, groups, faces, cancel, &det); !s.ok()) return s;
 
-  const Clock::time_point t0 = Clock::now();
-  internal::HypothesisJudge judge(frame.depth, options, &cancel);
-  BoxAcceptance acceptance(options, cancel, &judge, &det);
-  ProposeFromCorners(det, groups, options, &judge);
-  acceptance.AcceptAll();
-  std::vector<DeclinedCandidate> declined;
-  if (options.face_proposals) {
-    AcceptFaceTilesAndCheck(frame, faces, &judge, &acceptance, &det, &declined);
+  // Nothing found: the planar patches once more with a wider normal window
+  // (DetectorOptions::empty_frame_window_cells), unless the caller chose
+  // the window; the edge points, segments and corners stand as they are.
+  const DetectorOptions defaults;
+  if (det.boxes.empty() && options.empty_frame_window_cells > 0 && options.face_proposals &&
+      options_in.faces.patches.window_cells == defaults.faces.patches.window_cells &&
+      !det.edge_points.empty()) {
+    FaceProposalOptions wider = options.faces;
+    wider.patches.window_cells = options.empty_frame_window_cells;
+    const Clock::time_point t_faces = Clock::now();
+    const FaceProposals wider_faces = ProposeFromFaces(frame.depth, options.box, wider, &cancel);
+    det.timings.faces_ms += MsSince(t_faces);
+    if (absl::Status s = cancel.Check("the planar patches"); !s.ok()) return s;
+    if (absl::Status s = JudgeAndKeep(frame, groups, wider_faces, cancel, &det); !s.ok()) {
+      return s;
+    }
   }
-  AlignToLayerPlanes(frame.depth, options.box, options.layer_plane, &det.boxes);
-  if (absl::Status s = cancel.Check("the judging of hypotheses"); !s.ok()) return s;
-  std::stable_sort(det.boxes.begin(), det.boxes.end(),
-                   [](const DetectedBox& a, const DetectedBox& b) { return a.score > b.score; });
-  det.hypotheses = judge.stats();
-  declined.insert(declined.end(), judge.declined().begin(), judge.declined().end());
-  det.declined = StrongestDeclined(std::move(declined), det.boxes, options);
-  det.timings.poses_ms = MsSince(t0);
   det.timings.total_ms = MsSince(t_start);
   return det;
-}
-
-}  // namespace
-
-absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOptions& options,
-                                      const CancelToken& cancel) {
-  absl::StatusOr<Detection> det = DetectOnce(input, options, cancel);
-  const DetectorOptions defaults;
-  if (!det.ok() || !det->boxes.empty() || options.empty_frame_window_cells == 0 ||
-      !options.face_proposals ||
-      options.faces.patches.window_cells != defaults.faces.patches.window_cells ||
-      det->edge_points.empty()) {
-    return det;
-  }
-  DetectorOptions wider = options;
-  wider.faces.patches.window_cells = options.empty_frame_window_cells;
-  absl::StatusOr<Detection> again = DetectOnce(input, wider, cancel);
-  if (!again.ok()) return again.status();
-  again->timings.total_ms += det->timings.total_ms;
-  return again;
 }
 
 }  // namespace cornerpose

@@ -127,12 +127,12 @@ struct DetectorOptions {
   // with the corner ones. False gives the corner-only detector.
   bool face_proposals = true;
   FaceProposalOptions faces;
-  // A frame in which nothing is found is detected once more with the
-  // planar patches' normal window this wide (cells; PlanarPatchOptions::
-  // window_cells), unless the caller set that window: a pallet at 2-2.5 m
-  // from a stereo camera (~1 cm of noise) comes out of the 5 x 5 and 7 x 7
-  // windows in pieces too small to propose a face. Such a frame costs two
-  // detections. 0: never.
+  // A frame in which nothing is found has its planar patches found once
+  // more with the normal window this wide (cells; PlanarPatchOptions::
+  // window_cells), unless the caller set that window, and its hypotheses
+  // judged again (its edge points, segments and corners stand): a pallet
+  // at 2-2.5 m from a stereo camera (~1 cm of noise) comes out of the 5 x 5
+  // and 7 x 7 windows in pieces too small to propose a face. 0: never.
   int empty_frame_window_cells = 4;
   // With face proposals: no box reaches more than floor_tolerance_m through
   // the floor, the farthest plane the camera sees with planar patches of at
@@ -257,9 +257,9 @@ void DeriveGeometryParameters(double median_depth_m, double focal_px, DetectorOp
 // When `cancel` stops (its deadline passes or its caller goes away) the
 // detection ends within a few milliseconds with DEADLINE_EXCEEDED or
 // CANCELLED: it is checked between the stages and inside their long loops.
-// A frame with edge points in which nothing is found is detected once more
-// with a wider normal window (DetectorOptions::empty_frame_window_cells);
-// its timings' total then counts both.
+// A frame with edge points in which nothing is found has its faces found
+// and judged once more with a wider normal window (DetectorOptions::
+// empty_frame_window_cells); its faces and poses timings then count both.
 absl::StatusOr<Detection> DetectBoxes(const PointCloud& cloud, const DetectorOptions& options,
                                       const CancelToken& cancel = CancelToken());
 

