@@ -190,10 +190,34 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
       measured(u, a_r, b_r, n_r);
     };
     for (int u = ua; u <= left_end; ++u) both(u);
-    if (mid0 <= mid1) {
-      for (int u = std::max(ua, mid0); u <= std::min(ub, mid1); ++u) {
-        measured(u, a_x[u - ua] + a_row, b_x[u - ua] + b_row, n_x[u - ua] + n_row);
+    // The middle run without branches on the data: a point in no band
+    // only adds to the interior's sums (nothing when it is not interior, a
+    // no-return's NaN failing every test), in the same order; one in a
+    // band takes the general path.
+    auto middle = [&](int u) {
+      const double a_r = a_x[u - ua] + a_row, b_r = b_x[u - ua] + b_row, n_r = n_x[u - ua] + n_row;
+      const float z = zrow[u];
+      const double qa = z * a_r - a_c, qb = z * b_r - b_c, qn = z * n_r - n_c;
+      if (std::abs(qa) >= band_a || std::abs(qb) >= band_b) [[unlikely]] {
+        measured(u, a_r, b_r, n_r);
+        return;
       }
+      const bool in =
+          (std::abs(qn) <= plane_tol) & (std::abs(qa) <= inside_a) & (std::abs(qb) <= inside_b);
+      const double ma = in ? qa : 0.0, mb = in ? qb : 0.0, mn = in ? qn : 0.0;
+      out.interior += in;
+      sa += ma;
+      sb += mb;
+      sn += mn;
+      saa += ma * ma;
+      sab += ma * mb;
+      san += ma * mn;
+      sbb += mb * mb;
+      sbn += mb * mn;
+      snn += mn * mn;
+    };
+    if (mid0 <= mid1) {
+      for (int u = std::max(ua, mid0); u <= std::min(ub, mid1); ++u) middle(u);
       for (int u = std::max(ua, mid1 + 1); u <= ub; ++u) both(u);
     }
     out.sum += Eigen::Vector3d(sa, sb, sn);
@@ -235,16 +259,19 @@ void BucketSort(std::vector<T>* values, double lo, double hi, Key key) {
     const double b = (key(x) - lo) * scale;
     return b <= 0.0 ? size_t{0} : std::min(buckets - 1, static_cast<size_t>(b));
   };
-  std::vector<size_t> start(buckets + 1, 0);
+  // Scratch kept per thread (a refinement sorts a dozen bands).
+  thread_local std::vector<size_t> start, next;
+  thread_local std::vector<T> out;
+  start.assign(buckets + 1, 0);
   for (const T& x : *values) ++start[bucket_of(x) + 1];
   for (size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
-  std::vector<T> out(n);
-  std::vector<size_t> next(start.begin(), start.end() - 1);
+  out.resize(n);
+  next.assign(start.begin(), start.end() - 1);
   for (const T& x : *values) out[next[bucket_of(x)]++] = x;
   for (size_t b = 0; b < buckets; ++b) {
     if (start[b + 1] - start[b] > 1) std::sort(out.begin() + start[b], out.begin() + start[b + 1]);
   }
-  *values = std::move(out);
+  values->swap(out);
 }
 
 // The seam test over the points of one stretch of a side: strength(c) > 0
@@ -364,12 +391,25 @@ class SeamScan {
   // reads as a dip in density. Spread alike, both count smoothly.
   class SpreadSums {
    public:
-    void Build(const std::vector<double>& x, const std::vector<double>& y) {
-      x_ = x;
-      sum_.assign(x.size() + 1, Sums{});
-      for (size_t i = 0; i < x.size(); ++i) {
-        sum_[i + 1] = {sum_[i].x + x[i], sum_[i].y + y[i], sum_[i].xy + x[i] * y[i]};
+    // From values sorted by their x (xy(v) gives (x, y)).
+    template <typename T, typename XY>
+    void Build(const std::vector<T>& values, XY xy) {
+      const size_t n = values.size();
+      x_.resize(n);
+      sum_.assign(n + 1, Sums{});
+      for (size_t i = 0; i < n; ++i) {
+        const auto [x, y] = xy(values[i]);
+        x_[i] = x;
+        sum_[i + 1] = {sum_[i].x + x, sum_[i].y + y, sum_[i].xy + x * y};
       }
+      // Where each of n / 4 equal cells of x's range starts (CellOf).
+      cells_ = n >= 16 && x_.back() > x_.front() ? n / 4 : 0;
+      cell_start_.assign(cells_ + 1, 0);
+      if (cells_ == 0) return;
+      x0_ = x_.front();
+      scale_ = static_cast<double>(cells_) / (x_.back() - x_.front());
+      for (double x : x_) ++cell_start_[CellOf(x) + 1];
+      for (size_t c = 0; c < cells_; ++c) cell_start_[c + 1] += cell_start_[c];
     }
     size_t size() const { return x_.size(); }
     // (weighted count, weighted y-sum) over [lo, hi).
@@ -394,28 +434,34 @@ class SeamScan {
     struct Sums {
       double x = 0.0, y = 0.0, xy = 0.0;
     };
-    size_t Index(double v) const { return std::lower_bound(x_.begin(), x_.end(), v) - x_.begin(); }
+    // The cell of x's range that v falls in, clamped: monotonic in v, so
+    // every point of a lower cell lies below v and every point of a higher
+    // one above it, and the first point >= v lies within v's cell or at
+    // the next cell's start.
+    size_t CellOf(double v) const {
+      const double t = (v - x0_) * scale_;
+      return t <= 0.0 ? 0 : std::min(cells_ - 1, static_cast<size_t>(t));
+    }
+    // The first point >= v (std::lower_bound), searched within v's cell.
+    size_t Index(double v) const {
+      if (cells_ == 0) return std::lower_bound(x_.begin(), x_.end(), v) - x_.begin();
+      const size_t c = CellOf(v);
+      return std::lower_bound(x_.begin() + cell_start_[c], x_.begin() + cell_start_[c + 1], v) -
+             x_.begin();
+    }
     Sums Diff(size_t a, size_t b) const {
       return {sum_[b].x - sum_[a].x, sum_[b].y - sum_[a].y, sum_[b].xy - sum_[a].xy};
     }
     std::vector<double> x_;
     std::vector<Sums> sum_;
+    size_t cells_ = 0;
+    double x0_ = 0.0, scale_ = 0.0;
+    std::vector<size_t> cell_start_;
   };
 
   void Index() {
-    std::vector<double> x(rows_.size()), y(rows_.size());
-    for (size_t i = 0; i < rows_.size(); ++i) {
-      x[i] = rows_[i].across;
-      y[i] = rows_[i].height;
-    }
-    points_.Build(x, y);
-    x.resize(expected_.size());
-    y.resize(expected_.size());
-    for (size_t i = 0; i < expected_.size(); ++i) {
-      x[i] = expected_[i].across;
-      y[i] = expected_[i].hit;
-    }
-    grid_.Build(x, y);
+    points_.Build(rows_, [](const Row& r) { return std::pair{r.across, r.height}; });
+    grid_.Build(expected_, [](const Pixel& e) { return std::pair{e.across, e.hit}; });
   }
   // Count and height sum of points with across in [lo, hi).
   std::pair<double, double> Window(double lo, double hi) const {
@@ -679,35 +725,43 @@ template <typename Further>
 void RimAsFree(const std::array<SideMeasure*, 4>& sides, double half_a, double half_b,
                const RefinementOptions& o, const Further& further) {
   if (!EverySideSeen(sides)) return;
+  auto candidate = [&](int i) { return sides[i]->kind == SideKind::kContinues && sides[i]->rim; };
+  // The face so measured is the box's size on both axes: across the rim
+  // from rim_extent_tolerance_m short to twice it long (the rim adds to
+  // it), along it within the tolerance when both its sides are free (a face
+  // a rim too big is also what a box of another size shows). The opposite
+  // side must end the face (free, and below: for good).
+  auto fits = [&](int rim) {
+    const SideMeasure& m = *sides[rim];
+    const SideMeasure& opposite = *sides[rim ^ 1];
+    const double half = rim < 2 ? half_a : half_b, other_half = rim < 2 ? half_b : half_a;
+    const SideMeasure& o1 = *sides[rim < 2 ? 2 : 0];
+    const SideMeasure& o2 = *sides[rim < 2 ? 3 : 1];
+    const double over = m.rim_position + opposite.position - 2.0 * half;
+    return opposite.kind == SideKind::kFree && over >= -o.rim_extent_tolerance_m &&
+           over <= 2.0 * o.rim_extent_tolerance_m &&
+           !(o1.kind == SideKind::kFree && o2.kind == SideKind::kFree &&
+             std::abs(o1.position + o2.position - 2.0 * other_half) > o.rim_extent_tolerance_m);
+  };
+  // The strips past the sides (further) are read only where a rim could
+  // pass: on a layer of touching boxes every side runs on and none is free.
+  bool any_fits = false;
+  for (int i = 0; i < 4; ++i) any_fits = any_fits || (candidate(i) && fits(i));
+  if (!any_fits) return;
   // A rim: the face runs on past the side, but nothing of it a band further.
   int rims = 0, rim = -1;
-  for (int i = 0; i < 4; ++i) {
-    if (sides[i]->kind == SideKind::kContinues && sides[i]->rim &&
-        further(i) <= o.free_side_ratio) {
+  for (int i = 0; i < 4 && rims < 2; ++i) {
+    if (candidate(i) && further(i) <= o.free_side_ratio) {
       ++rims;
       rim = i;
     }
   }
-  if (rims != 1) return;
+  if (rims != 1 || !fits(rim)) return;
   // The opposite side must end the face for good: no plane resuming past
   // it (a strip of missing returns across a face, as dark tape leaves on a
   // stereo camera, ends half of it at a free side).
-  const SideMeasure& opposite = *sides[rim ^ 1];
-  if (opposite.kind != SideKind::kFree || further(rim ^ 1) > o.free_side_ratio) return;
-  // The face so measured is the box's size on both axes: across the rim
-  // from rim_extent_tolerance_m short to twice it long (the rim adds to
-  // it), along it within the tolerance when both its sides are free (a face
-  // a rim too big is also what a box of another size shows).
+  if (further(rim ^ 1) > o.free_side_ratio) return;
   SideMeasure& m = *sides[rim];
-  const double half = rim < 2 ? half_a : half_b, other_half = rim < 2 ? half_b : half_a;
-  const SideMeasure& o1 = *sides[rim < 2 ? 2 : 0];
-  const SideMeasure& o2 = *sides[rim < 2 ? 3 : 1];
-  const double over = m.rim_position + opposite.position - 2.0 * half;
-  if (over < -o.rim_extent_tolerance_m || over > 2.0 * o.rim_extent_tolerance_m ||
-      (o1.kind == SideKind::kFree && o2.kind == SideKind::kFree &&
-       std::abs(o1.position + o2.position - 2.0 * other_half) > o.rim_extent_tolerance_m)) {
-    return;
-  }
   m.kind = SideKind::kFree;
   m.position = m.rim_position;
   m.slope = m.rim_slope;
