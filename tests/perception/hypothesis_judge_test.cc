@@ -172,6 +172,34 @@ TEST(HypothesisJudgeTest, AHypothesisDeepInsideAKeptBoxIsNotJudged) {
   EXPECT_EQ(judge.stats().proposed, 1);
 }
 
+// Within one batch, a hypothesis inside a box accepted before it (in the
+// order proposed) is not judged (AcceptanceOptions::settle_within_batch):
+// the box comes out once, refined once, on one thread or two (the second
+// thread may judge it before the first is accepted; that verdict is
+// dropped). Rule off: both are judged and accepted.
+TEST(HypothesisJudgeTest, AHypothesisInsideOneAcceptedEarlierInItsBatchIsNotJudged) {
+  const RenderedDepth b = RenderOneBox();
+  const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;
+  for (const bool within : {true, false}) {
+    for (const int threads : {1, 2}) {
+      DetectorOptions o;
+      o.box = kCartonS;
+      o.acceptance.settle_within_batch = within;
+      internal::HypothesisJudge judge(b.depth, o);
+      judge.Propose(gt, 0, {});
+      judge.Propose(Moved(gt, 0.02), 0, {});
+      const std::vector<internal::Candidate> found = judge.Evaluate(threads);
+      ASSERT_EQ(found.size(), within ? 1u : 2u) << within << " " << threads;
+      EXPECT_EQ(judge.stats().refined, within ? 1 : 2) << within << " " << threads;
+      EXPECT_EQ(judge.stats().proposed, within ? 1 : 2) << within << " " << threads;
+      EXPECT_LT(ComparePoses(found[0].box.camera_T_box, gt, kCartonS).translation_m, 0.005);
+      // The one not judged may be proposed again (as if never proposed).
+      judge.Propose(Moved(gt, 0.02), 0, {});
+      EXPECT_EQ(judge.Queued(), within) << threads;
+    }
+  }
+}
+
 // A pose whose grasp face runs out of the image but whose face centre and
 // some of each side are in view goes on to refinement when a face measured
 // on every side may leave the view (the final check then decides); with

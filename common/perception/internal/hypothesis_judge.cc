@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <mutex>
 #include <numbers>
 #include <optional>
 
@@ -202,13 +203,57 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads,
       });
     }
   }
-  // Work is uneven (most hypotheses fail the first check), so threads take
-  // the next hypothesis when done with one.
+  // A hypothesis inside a box accepted before it in the batch (in the
+  // order proposed) with all four sides free is settled too
+  // (AcceptanceOptions::settle_within_batch): a box's corners, tiles and
+  // neighbours propose it, and other readings of its place, several times
+  // over. Threads take the next hypothesis when done with one (work
+  // is uneven: most fail the first check); one whose predecessors are not
+  // all judged yet is judged anyway unless a judged one already settles it,
+  // and its verdict is dropped if a predecessor settles it after all. The
+  // verdicts are those of judging one by one, whatever the threads' timing.
+  const double m = options_.acceptance.settled_overlap_margin_m;
+  const bool within = options_.acceptance.settle_within_batch && m > 0.0;
+  // Hypothesis k lies inside one accepted among the first `upto` whose
+  // face ends in a free border on all four sides: nothing judged after it
+  // there could rank above it (AcceptAll keeps the most free sides first),
+  // but for a higher score with as many.
+  auto inside_accepted = [&](int k, int upto) {
+    for (int j = 0; within && j < std::min(k, upto); ++j) {
+      if (accepted[j] && results[j].refinement.free_sides >= 4 &&
+          BoxesOverlap(results[j].box.camera_T_box, queue_[k].camera_T_box, options_.box, m)) {
+        return true;
+      }
+    }
+    return false;
+  };
+  std::vector<char> done(n, 0);
+  std::mutex mu;
+  int final_prefix = 0;  // [0, final_prefix): judged, verdicts final
   ParallelForChunks(n, 1, threads, [&](int, int i, int) {
-    if (StopRequested(cancel_) || settled[i]) return;
-    bool r = false;
-    accepted[i] = EvaluateOne(queue_[i], kept, &results[i], &r, &reasons[i]);
-    refined[i] = r;
+    bool judge = false;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      if (!settled[i] && inside_accepted(i, final_prefix)) settled[i] = 1;
+      judge = !settled[i];
+    }
+    if (judge && !StopRequested(cancel_)) {
+      bool r = false;
+      const bool ok = EvaluateOne(queue_[i], kept, &results[i], &r, &reasons[i]);
+      std::lock_guard<std::mutex> lock(mu);
+      accepted[i] = ok;
+      refined[i] = r;
+    }
+    std::lock_guard<std::mutex> lock(mu);
+    done[i] = 1;
+    for (; final_prefix < n && done[final_prefix]; ++final_prefix) {
+      const int f = final_prefix;
+      if (!settled[f] && inside_accepted(f, f)) {  // judged before that was known
+        settled[f] = 1;
+        accepted[f] = 0;
+        refined[f] = 0;
+      }
+    }
   });
   std::vector<Candidate> out;
   std::vector<Eigen::Isometry3d> turned;  // DetectorOptions::turned_proposals
