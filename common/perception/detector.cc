@@ -609,30 +609,39 @@ absl::Status FindEdgesAndFaces(const PreparedFrame& f, const CancelToken& cancel
   // segments and corners. Done with them, that thread helps fit the
   // segments (their RANSAC iterations are shared loops), so neither stage
   // waits on the other. Beyond two threads, the others help from the start.
-  internal::SharedLoops shared;
+  // The other way round too: done with the segments, the other threads
+  // help tile the patches, one patch at a time (on pallets the patches take
+  // twice as long as the segments).
+  internal::SharedLoops shared, face_loops;
   const bool share = options.face_proposals && options.num_threads > 1;
   {
     std::jthread faces_thread;  // joined at the end of this block, on every path
     if (options.face_proposals) {
       faces_thread = std::jthread([&] {
         const Clock::time_point t_faces = Clock::now();
-        *faces = ProposeFromFaces(f.depth, options.box, options.faces, &cancel);
+        *faces = ProposeFromFaces(f.depth, options.box, options.faces, &cancel,
+                                  share ? &face_loops : nullptr);
         det->timings.faces_ms = MsSince(t_faces);
+        face_loops.Close();
         if (share) shared.Help();
       });
     }
     std::vector<std::jthread> helpers;
     for (int t = 2; share && t < options.num_threads; ++t) {
-      helpers.emplace_back([&] { shared.Help(); });
+      helpers.emplace_back([&] {
+        shared.Help();
+        face_loops.Help();
+      });
     }
     t0 = Clock::now();
     absl::StatusOr<std::vector<EdgeSegment>> segments =
         FitEdgeSegments(det->edge_points, options.segments, share ? &shared : nullptr, &cancel);
     shared.Close();
+    det->timings.edge_segments_ms = MsSince(t0);
+    if (share) face_loops.Help();
     helpers.clear();  // joined
     if (!segments.ok()) return segments.status();
     det->segments = *std::move(segments);
-    det->timings.edge_segments_ms = MsSince(t0);
   }
   if (absl::Status s = cancel.Check("the edge segments and planar patches"); !s.ok()) return s;
 

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "common/perception/internal/parallel.h"
 
 namespace cornerpose {
 namespace {
@@ -198,12 +199,19 @@ double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const Fa
   return sides > 0 ? static_cast<double>(seams) / sides : 0.0;
 }
 
-FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
-                               const FaceProposalOptions& o, const CancelToken* cancel) {
-  FaceProposals out;
-  out.patches = SegmentPlanarPatches(image, o.patches);
-  const PlanarPatches& patches = out.patches;
-  out.num_patches = static_cast<int>(patches.patches.size());
+namespace {
+
+// What one patch proposes (ProposeFromFaces, the patches' in order).
+struct PatchProposals {
+  std::vector<Eigen::Isometry3d> poses;
+  std::vector<DeclinedCandidate> declined;
+  std::vector<LayerTiles> layers;
+};
+
+// The faces, layer tiles and ambiguous tilings of patch `id`.
+void ProposeFromPatch(const DepthImage& image, const PlanarPatches& patches, size_t id,
+                      const BoxDims& dims, const FaceProposalOptions& o, PatchProposals* out_ptr) {
+  PatchProposals& out = *out_ptr;
   std::array<double, 3> sorted = {dims.l, dims.b, dims.h};
   std::sort(sorted.begin(), sorted.end());
   const double smallest_face = sorted[0] * sorted[1];
@@ -216,12 +224,12 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
         SeamSplitFaces(image, patches, static_cast<int>(id), rect, dims, o.seam_split);
     out.poses.insert(out.poses.end(), split.begin(), split.end());
   };
-  for (size_t id = 0; id < patches.patches.size() && !StopRequested(cancel); ++id) {
+  {
     const PlanarPatch& patch = patches.patches[id];
     const double cell_m = patch.centroid.z() / image.camera.fx * patches.step_px;
     const double area = patch.points.size() * cell_m * cell_m;
-    if (area < 0.5 * smallest_face) continue;
-    if (patch.normal.dot(-patch.centroid.normalized()) < cos_view) continue;
+    if (area < 0.5 * smallest_face) return;
+    if (patch.normal.dot(-patch.centroid.normalized()) < cos_view) return;
     const PlaneRectangle rect = OutlineRectangle(patch);
     // An outline cut by the image border says nothing about where a layer
     // ends. One no bigger than a face may still be that face whole (a box
@@ -236,11 +244,11 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     if (at_border &&
         (!o.propose_at_border || rect.width > largest_side || rect.height > largest_side)) {
       if (o.propose_at_border) anchor_and_split(id, rect, cell_m);
-      continue;
+      return;
     }
     // A patch filling little of its outline is no face or layer (a floor
     // around things, an L of two boxes' sides).
-    if (area < 0.5 * rect.width * rect.height) continue;
+    if (area < 0.5 * rect.width * rect.height) return;
     // A tile is proposed only where the patch is (a layer can be notched
     // where boxes were taken).
     auto on_patch = [&](const Eigen::Isometry3d& pose, const FaceTiling& t) {
@@ -306,7 +314,7 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
       // floor, a wall, a layer cut by the image border).
       if (rect.width > largest_side || rect.height > largest_side) {
         anchor_and_split(id, rect, cell_m);
-        continue;
+        return;
       }
       for (int n = 0; n < 3; ++n) {
         const int a = (n + 1) % 3, b = (n + 2) % 3;
@@ -334,12 +342,12 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
           }
         }
       }
-      continue;
+      return;
     }
     if (tilings.size() == 1) {
       propose(tilings[0]);
       in_play({tilings[0]});
-      continue;
+      return;
     }
     // Several tilings fit: seam cues first, then the fewest boxes.
     std::vector<double> support(tilings.size(), 0.0);
@@ -360,7 +368,7 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
     if (chosen >= 0) {
       propose(tilings[chosen]);
       in_play({tilings[chosen]});
-      continue;
+      return;
     }
     in_play({tilings[0], tilings[1]});
     for (size_t i = 0; i < tilings.size() && i < 2; ++i) {
@@ -371,6 +379,36 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
           rect.height, Describe(tilings[0], dims), Describe(tilings[1], dims));
       out.declined.push_back(d);
     }
+  }
+}
+
+}  // namespace
+
+FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
+                               const FaceProposalOptions& o, const CancelToken* cancel,
+                               internal::SharedLoops* helpers) {
+  FaceProposals out;
+  out.patches = SegmentPlanarPatches(image, o.patches);
+  const PlanarPatches& patches = out.patches;
+  out.num_patches = static_cast<int>(patches.patches.size());
+  // Patch by patch, each into its own slot (with helpers, in any order on
+  // any thread), gathered in patch order: the same proposals either way.
+  std::vector<PatchProposals> per_patch(patches.patches.size());
+  auto propose = [&](int begin, int end) {
+    for (int id = begin; id < end && !StopRequested(cancel); ++id) {
+      ProposeFromPatch(image, patches, id, dims, o, &per_patch[id]);
+    }
+  };
+  const int n = static_cast<int>(per_patch.size());
+  if (helpers != nullptr) {
+    helpers->Run(n, 1, propose);
+  } else {
+    propose(0, n);
+  }
+  for (PatchProposals& p : per_patch) {
+    out.poses.insert(out.poses.end(), p.poses.begin(), p.poses.end());
+    out.declined.insert(out.declined.end(), p.declined.begin(), p.declined.end());
+    for (LayerTiles& l : p.layers) out.layers.push_back(std::move(l));
   }
   return out;
 }

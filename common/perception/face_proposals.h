@@ -23,6 +23,10 @@
 #include "common/perception/seam_split_faces.h"
 #include "common/perception/types.h"
 
+namespace cornerpose::internal {
+class SharedLoops;
+}  // namespace cornerpose::internal
+
 namespace cornerpose {
 
 struct FaceProposalOptions {
@@ -135,9 +139,12 @@ struct FaceProposals {
 };
 
 // A stopped `cancel` (may be null) ends the tiling early, with what it has.
+// With `helpers` (may be null), the patches are shared out as a loop other
+// threads may help with (internal::SharedLoops); the proposals are the same.
 FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
                                const FaceProposalOptions& options,
-                               const CancelToken* cancel = nullptr);
+                               const CancelToken* cancel = nullptr,
+                               internal::SharedLoops* helpers = nullptr);
 
 // The layer (an index into faces.layers) a grasp face (centre and outward
 // normal, camera frame) lies on: on its patch, facing its way, on its plane,

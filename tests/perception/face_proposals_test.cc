@@ -9,9 +9,11 @@
 #include <limits>
 #include <random>
 #include <set>
+#include <thread>
 #include <utility>
 #include <vector>
 
+#include "common/perception/internal/parallel.h"
 #include "common/perception/planar_patches.h"
 #include "common/perception/seam_cues.h"
 
@@ -217,6 +219,33 @@ TEST(FaceProposalsTest, ALayerOfTouchingBoxesWithNoSeamsTilesIntoItsBoxes) {
   EXPECT_TRUE(p.declined.empty());
   ASSERT_EQ(p.poses.size(), 6u);
   ExpectTiles(f, p.poses, 0.30, 0.20);
+}
+
+// With helpers (internal::SharedLoops, as the detector's segments thread
+// helps when done), the patches are tiled on two threads: the proposals,
+// layers and declined tilings are those of one thread, in the same order.
+TEST(FaceProposalsTest, PatchesSharedWithAHelperProposeTheSame) {
+  LayerFrame f;  // a layer and the floor around it: two patches
+  f.Render();
+  const FaceProposals alone = ProposeFromFaces(f.image, kCarton, FaceProposalOptions{});
+  ASSERT_GE(alone.num_patches, 2);
+  ASSERT_FALSE(alone.poses.empty());
+  internal::SharedLoops loops;
+  std::thread helper([&] { loops.Help(); });
+  const FaceProposals shared =
+      ProposeFromFaces(f.image, kCarton, FaceProposalOptions{}, nullptr, &loops);
+  loops.Close();
+  helper.join();
+  ASSERT_EQ(shared.poses.size(), alone.poses.size());
+  for (size_t i = 0; i < alone.poses.size(); ++i) {
+    EXPECT_TRUE(shared.poses[i].isApprox(alone.poses[i], 0.0)) << i;
+  }
+  ASSERT_EQ(shared.layers.size(), alone.layers.size());
+  for (size_t i = 0; i < alone.layers.size(); ++i) {
+    EXPECT_EQ(shared.layers[i].patch, alone.layers[i].patch);
+    EXPECT_EQ(shared.layers[i].tiles.size(), alone.layers[i].tiles.size());
+  }
+  EXPECT_EQ(shared.declined.size(), alone.declined.size());
 }
 
 // A carton top whose rim the segmentation took in (here the outline is
