@@ -700,11 +700,18 @@ double FurtherShare(const DepthImage& depth, const FaceFrame& f, int side, int i
   const int slack =
       1 + static_cast<int>(std::ceil(2.0 * plane_tol * k.fx / std::max(0.1, f.c.z())));
   int further = 0;
+  const int u0 = std::max(0, r->u0 - slack), u1 = std::min(k.width - 1, r->u1 + slack);
+  // The rays' x per column, computed once (PixelRay's own values).
+  thread_local std::vector<double> ray_x;
+  ray_x.resize(std::max(0, u1 - u0 + 1));
+  for (int u = u0; u <= u1; ++u) ray_x[u - u0] = PixelRay(k, u, 0).x();
   for (int v = std::max(0, r->v0 - slack); v <= std::min(k.height - 1, r->v1 + slack); ++v) {
-    for (int u = std::max(0, r->u0 - slack); u <= std::min(k.width - 1, r->u1 + slack); ++u) {
+    const double ray_y = PixelRay(k, 0, v).y();
+    for (int u = u0; u <= u1; ++u) {
       const float z = depth.at(u, v);
       if (std::isnan(z)) continue;
-      const Eigen::Vector3d d = static_cast<double>(z) * PixelRay(k, u, v) - f.c;
+      const Eigen::Vector3d d =
+          static_cast<double>(z) * Eigen::Vector3d(ray_x[u - u0], ray_y, 1.0) - f.c;
       if (std::abs(d.dot(f.n)) > 2.0 * plane_tol) continue;
       const double out = d.dot(across);
       further +=

@@ -177,12 +177,6 @@ absl::Status PlanarPatchOptions::Validate() const {
   return absl::OkStatus();
 }
 
-int PlanarPatches::PatchAt(int u, int v) const {
-  const int cu = u / step_px, cv = v / step_px;
-  if (u < 0 || v < 0 || cu >= cells_wide || cv >= cells_high) return -1;
-  return label[static_cast<size_t>(cv) * cells_wide + cu];
-}
-
 PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOptions& o) {
   PlanarPatches out;
   const CameraIntrinsics& k = depth.camera;

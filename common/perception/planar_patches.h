@@ -58,8 +58,12 @@ struct PlanarPatches {
   // Per cell (row-major, cells_wide x cells_high): the patch index, or -1.
   std::vector<int> label;
   int cells_wide = 0, cells_high = 0, step_px = 1;
-  // The patch at a pixel, or -1.
-  int PatchAt(int u, int v) const;
+  // The patch at a pixel, or -1 (inline: the tiling reads it per sample).
+  int PatchAt(int u, int v) const {
+    const int cu = u / step_px, cv = v / step_px;
+    if (u < 0 || v < 0 || cu >= cells_wide || cv >= cells_high) return -1;
+    return label[static_cast<size_t>(cv) * cells_wide + cu];
+  }
 };
 
 PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOptions& options);
