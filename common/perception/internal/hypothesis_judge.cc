@@ -231,13 +231,16 @@ std::vector<Candidate> HypothesisJudge::Evaluate(int threads,
   std::mutex mu;
   int final_prefix = 0;  // [0, final_prefix): judged, verdicts final
   ParallelForChunks(n, 1, threads, [&](int, int i, int) {
+    // Polled once a hypothesis, judged or not (the polls a cancellation
+    // counts do not depend on the threads' timing).
+    const bool stop = StopRequested(cancel_);
     bool judge = false;
     {
       std::lock_guard<std::mutex> lock(mu);
       if (!settled[i] && inside_accepted(i, final_prefix)) settled[i] = 1;
       judge = !settled[i];
     }
-    if (judge && !StopRequested(cancel_)) {
+    if (judge && !stop) {
       bool r = false;
       const bool ok = EvaluateOne(queue_[i], kept, &results[i], &r, &reasons[i]);
       std::lock_guard<std::mutex> lock(mu);
