@@ -69,6 +69,9 @@ constexpr char kHelp[] =
     "  --pairs BOOL         two boxes declined only for one side running on flat, those\n"
     "                       sides against each other, end each other when both pass\n"
     "                       so and their outline tiles one way with two faces (true)\n"
+    "  --seen_through S     a reading with no point just inside one side, where that\n"
+    "                       share of the pixels there not hidden see behind its plane,\n"
+    "                       is declined: the face ends before that side (0.4; 0: off)\n"
     "  --level_check M      a box whose top is level with a box beside it but whose\n"
     "                       bottom would lie more than M below that one's is taken\n"
     "                       out (0.05; 0: off)\n"
@@ -189,6 +192,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("out_of_view", &options.acceptance.face_may_run_out_of_view),
         args.SetBool("kept_seams", &options.acceptance.kept_box_ends_side),
         args.SetBool("pairs", &options.acceptance.pairs_end_each_other),
+        args.SetDouble("seen_through", &options.refinement.seen_through_share),
         args.SetInt("empty_window", &options.empty_frame_window_cells),
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("seam_split", &options.faces.seam_split.enabled),
@@ -310,6 +314,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "out_of_view",
                                                        "kept_seams",
                                                        "pairs",
+                                                       "seen_through",
                                                        "empty_window",
                                                        "anchored_faces",
                                                        "seam_split",

@@ -148,8 +148,12 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
       if (std::abs(qa) <= lim_a && std::abs(qb) <= lim_b &&
           (std::abs(qa) > in_a || std::abs(qb) > in_b)) {
         const float z = zrow[u];
-        const bool hit = !std::isnan(z) && std::abs(z * n_r - n_c) <= plane_tol;
-        to_sides(FacePoint{qa, qb, hit ? 1.0 : 0.0}, out.grid);
+        const double off = z * n_r - n_c;  // NaN where no return
+        const bool hit = !std::isnan(z) && std::abs(off) <= plane_tol;
+        // 1: a point on the plane; -1: one behind it (the plane is not
+        // there); 0.5: one in front of it (hiding it); 0: no return.
+        const double n = hit ? 1.0 : off < -plane_tol ? -1.0 : off > plane_tol ? 0.5 : 0.0;
+        to_sides(FacePoint{qa, qb, n}, out.grid);
       }
     };
     // The measured point, every pixel.
@@ -235,6 +239,9 @@ struct SideMeasure {
   // kSeam only: found past the symmetric search window, in its outward
   // extension (see OutwardSeamsNeedEverySide).
   bool outward_seam = false;
+  // kUnknown only: most pixels just inside the side see past the plane
+  // (behind where the face would be): the face ends before the side.
+  bool seen_through = false;
   // kContinues only: where the face's points end within the band.
   bool rim = false;
   double rim_position = 0.0, rim_slope = 0.0;
@@ -296,7 +303,7 @@ class SeamScan {
     }
     for (const FacePoint& p : grid) {  // where pixels meet the plane, same band
       double across, along;
-      if (band(p, &across, &along)) expected_.push_back({across, along, p.n});
+      if (band(p, &across, &along)) expected_.push_back({across, along, p.n == 1.0 ? 1.0 : 0.0});
     }
     BucketSort(&expected_, -reach, reach, [](const Pixel& e) { return e.across; });
     BucketSort(&rows, -reach, reach, [](const Row& r) { return r.across; });
@@ -590,7 +597,24 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
     }
   }
   SideMeasure m;
-  if (inner < 10) return m;  // hidden or cut: no say
+  if (inner < 10) {  // hidden or cut: no say, unless seen through
+    // The pixels just inside the side: where nothing in front hides the
+    // plane, do they see behind it?
+    int pixels = 0, behind = 0, hidden = 0;
+    for (const FacePoint& g : grid) {
+      const double across = sign * (along_a ? g.a : g.b);
+      const double along = along_a ? g.b : g.a;
+      if (std::abs(along) > half_other - band || across < half - band || across >= half - 0.005) {
+        continue;
+      }
+      ++pixels;
+      behind += g.n < 0.0;
+      hidden += g.n == 0.5;
+    }
+    m.seen_through = o.seen_through_share > 0.0 && behind >= 10 &&
+                     behind >= o.seen_through_share * (pixels - hidden);
+    return m;
+  }
   m.inner = inner;
   // Something in front of the plane just past the side: the face may go on
   // underneath it, so the side is not where the face ends.
@@ -994,6 +1018,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.seam_turn_max_deg", seam_turn_max_deg, 0.0, 45.0),
            CheckRange("refinement.slat_gap_min_m", slat_gap_min_m, 0.0, 0.5),
            CheckRange("refinement.slat_gap_max_m", slat_gap_max_m, 0.0, 0.5),
+           CheckRange("refinement.seen_through_share", seen_through_share, 0.0, 1.0),
            CheckPositive("refinement.max_shift_m", max_shift_m),
            CheckPositive("refinement.max_turn_deg", max_turn_deg),
        }) {
@@ -1059,6 +1084,7 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
     });
   }
   result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
+  result.seen_through = {pa.seen_through, ma.seen_through, pb.seen_through, mb.seen_through};
   result.free_sides = 0;
   for (SideKind k : result.sides) result.free_sides += k == SideKind::kFree;
   auto offset = [](const SideMeasure& plus, const SideMeasure& minus, double half) {

@@ -124,6 +124,13 @@ struct RefinementOptions {
   // gaps_check). slat_gap_max_m 0 turns it off. Metres.
   double slat_gap_min_m = 0.015;
   double slat_gap_max_m = 0.06;
+  // A side with no point on the plane just inside it (kUnknown: hidden,
+  // or a shadow's missing returns) where at least this share of the pixels
+  // there (10 or more) see behind the plane is seen through
+  // (RefinementResult::seen_through): the face ends before it, and a face
+  // that big is not there (a carton lying on its 0.25 x 0.20 side read as
+  // its 0.25 x 0.25 end). 0 turns it off. Unitless, [0, 1].
+  double seen_through_share = 0.4;
   // Largest correction accepted, beyond which the hypothesis is not this
   // box: metres and degrees.
   double max_shift_m = 0.05;
@@ -156,6 +163,10 @@ struct RefinementResult {
   // point (camera frame) where the face's plane goes on past a gap beyond
   // the side (RefinementOptions::slat_gap_min_m), if it does.
   std::array<std::optional<Eigen::Vector3d>, 4> past_gap;
+  // Per side, kUnknown ones only: the pixels just inside it see behind the
+  // face's plane (RefinementOptions::seen_through_share): the face does not
+  // reach the side.
+  std::array<bool, 4> seen_through{};
 };
 
 // Refines camera_T_box in place using the face `grasp_face`.

@@ -324,6 +324,37 @@ TEST(RefineOnGraspFaceTest, AReadingOnABiggerFaceEndsAfterItsFirstStep) {
   EXPECT_FALSE(slid_pose.isApprox(refine(0.01, one_step).second, 1e-12));
 }
 
+// A face read 5 cm wider than the carton's top (a box of 0.30 x 0.25
+// placed on a 0.30 x 0.20 top, its -b side on the carton's): just inside
+// its +b side the pixels see the floor, behind the plane: the side is
+// unknown (no point on the plane there) and seen through. With the share 0
+// the rule is off; a side with nothing behind it (the true top's) is not.
+TEST(RefineOnGraspFaceTest, ASideWhereThePixelsSeeBehindThePlaneIsSeenThrough) {
+  const FlatScene s = RenderFlat({Flat(kCartonS, 0.0, 0.0)});
+  const GroundTruthBox& gt = s.rendered.boxes[0];
+  const BoxDims wide{0.30, 0.25, 0.15};
+  for (const double share : {0.4, 0.0}) {
+    RefinementOptions o;
+    o.seen_through_share = share;
+    Eigen::Isometry3d pose = Moved(gt.camera_T_box, 0.0, 0.025, 0.0);
+    const RefinementResult r = RefineOnGraspFace(s.depth, wide, TopFace(gt), o, &pose);
+    ASSERT_TRUE(r.ok) << share;
+    int unknown = -1;
+    for (int i = 0; i < 4; ++i) {
+      if (r.sides[i] == SideKind::kUnknown) unknown = i;
+    }
+    ASSERT_GE(unknown, 2) << "a side along the box's x, unseen";
+    EXPECT_EQ(r.seen_through[unknown], share > 0.0) << share;
+    for (int i = 0; i < 4; ++i) {
+      if (i != unknown) EXPECT_FALSE(r.seen_through[i]) << i;
+    }
+  }
+  // The carton read as itself: no side seen through.
+  Eigen::Isometry3d pose = gt.camera_T_box;
+  const RefinementResult r = RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), {}, &pose);
+  for (int i = 0; i < 4; ++i) EXPECT_FALSE(r.seen_through[i]) << i;
+}
+
 TEST(RefinementOptionsTest, ValidateNamesTheNewFields) {
   RefinementOptions o;
   EXPECT_TRUE(o.Validate().ok());
@@ -333,6 +364,9 @@ TEST(RefinementOptionsTest, ValidateNamesTheNewFields) {
   EXPECT_TRUE(o.Validate().ok()) << "0: every step";
   o.seam_turn_max_deg = 90.0;
   EXPECT_NE(o.Validate().message().find("seam_turn_max_deg"), std::string::npos);
+  o.seam_turn_max_deg = 10.0;
+  o.seen_through_share = 1.5;
+  EXPECT_NE(o.Validate().message().find("seen_through_share"), std::string::npos);
 }
 
 // A carton of the layer under another that stands on it right at the

@@ -375,6 +375,24 @@ TEST(HypothesisJudgeTest, ANeighbourNotBoxedInIsASteppingStone) {
 // as an occluded one does: a square carton read on a 0.25 x 0.20 side face
 // whose 0.20 side is unseen could as well be lying flat, its 0.25 x 0.25
 // top running on into the shadow.
+// A side with no point just inside it whose pixels see behind the plane
+// (RefinementResult::seen_through): the face ends before it, whatever the
+// other sides say; not where the side is out of view.
+TEST(RefinementVerdictTest, ASideSeenThroughDeclinesTheReading) {
+  constexpr BoxDims kCartonSq{0.25, 0.25, 0.20};
+  RefinementResult ref;
+  ref.ok = true;
+  ref.sides = {SideKind::kFree, SideKind::kFree, SideKind::kFree, SideKind::kUnknown};
+  ref.free_sides = 3;
+  AcceptanceOptions o;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonSq, BoxFace::kPlusZ, o), "");
+  ref.seen_through[3] = true;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonSq, BoxFace::kPlusZ, o)
+                .rfind("the face is seen through just inside a side", 0),
+            0u);
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonSq, BoxFace::kPlusZ, o, /*out_of_view=*/3), "");
+}
+
 TEST(RefinementVerdictTest, AnUnseenSideWhereALongerSideCouldStandIsDeclined) {
   constexpr BoxDims kCartonSq{0.25, 0.25, 0.20};
   RefinementResult ref;

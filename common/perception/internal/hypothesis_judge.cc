@@ -45,6 +45,13 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
     }
     measured += k == SideKind::kFree || k == SideKind::kSeam || k == SideKind::kTiled;
   }
+  // A side the face does not reach (seen through just inside it:
+  // RefinementOptions::seen_through_share): the face there is smaller.
+  for (int s = 0; s < 4; ++s) {
+    if (ref.sides[s] == SideKind::kUnknown && ref.seen_through[s] && s != out_of_view_side) {
+      return "the face is seen through just inside a side: it ends before it (a smaller face?)";
+    }
+  }
   // A side out of view that what is in view pins (SideOutOfViewPinned)
   // counts as measured: the box's size says where the face ends there.
   measured += out_of_view_side >= 0;
