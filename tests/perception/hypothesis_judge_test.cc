@@ -390,7 +390,8 @@ TEST(RefinementVerdictTest, ASideSeenThroughDeclinesTheReading) {
   EXPECT_EQ(internal::RefinementVerdict(ref, kCartonSq, BoxFace::kPlusZ, o)
                 .rfind("the face is seen through just inside a side", 0),
             0u);
-  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonSq, BoxFace::kPlusZ, o, /*out_of_view=*/3), "");
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonSq, BoxFace::kPlusZ, o, /*out_of_view_side=*/3),
+            "");
 }
 
 TEST(RefinementVerdictTest, AnUnseenSideWhereALongerSideCouldStandIsDeclined) {
