@@ -371,19 +371,23 @@ TEST(HypothesisJudgeTest, ANeighbourNotBoxedInIsASteppingStone) {
   EXPECT_EQ(stones[0].steps, 1);
 }
 
-// A side with nothing seen near it (kUnknown: a shadow) may hide more face,
-// as an occluded one does: a square carton read on a 0.25 x 0.20 side face
-// whose 0.20 side is unseen could as well be lying flat, its 0.25 x 0.25
-// top running on into the shadow.
+// A refined face read free on every side but `unseen` (kUnknown: nothing
+// on the plane just inside it).
+RefinementResult ReadWithOneUnseenSide(int unseen) {
+  RefinementResult ref;
+  ref.ok = true;
+  ref.sides = {SideKind::kFree, SideKind::kFree, SideKind::kFree, SideKind::kFree};
+  ref.sides[unseen] = SideKind::kUnknown;
+  ref.free_sides = 3;
+  return ref;
+}
+
 // A side with no point just inside it whose pixels see behind the plane
 // (RefinementResult::seen_through): the face ends before it, whatever the
 // other sides say; not where the side is out of view.
 TEST(RefinementVerdictTest, ASideSeenThroughDeclinesTheReading) {
   constexpr BoxDims kCartonSq{0.25, 0.25, 0.20};
-  RefinementResult ref;
-  ref.ok = true;
-  ref.sides = {SideKind::kFree, SideKind::kFree, SideKind::kFree, SideKind::kUnknown};
-  ref.free_sides = 3;
+  RefinementResult ref = ReadWithOneUnseenSide(3);
   AcceptanceOptions o;
   EXPECT_EQ(internal::RefinementVerdict(ref, kCartonSq, BoxFace::kPlusZ, o), "");
   ref.seen_through[3] = true;
@@ -394,13 +398,14 @@ TEST(RefinementVerdictTest, ASideSeenThroughDeclinesTheReading) {
             "");
 }
 
+// A side with nothing seen near it (kUnknown: a shadow) may hide more face,
+// as an occluded one does: a square carton read on a 0.25 x 0.20 side face
+// whose 0.20 side is unseen could as well be lying flat, its 0.25 x 0.25
+// top running on into the shadow.
 TEST(RefinementVerdictTest, AnUnseenSideWhereALongerSideCouldStandIsDeclined) {
   constexpr BoxDims kCartonSq{0.25, 0.25, 0.20};
-  RefinementResult ref;
-  ref.ok = true;
   // +y face: its a axis is the box's z (0.20), its b axis the box's x (0.25).
-  ref.sides = {SideKind::kUnknown, SideKind::kFree, SideKind::kFree, SideKind::kFree};
-  ref.free_sides = 3;
+  RefinementResult ref = ReadWithOneUnseenSide(0);
   AcceptanceOptions o;
   EXPECT_EQ(internal::RefinementVerdict(ref, kCartonSq, BoxFace::kPlusY, o),
             "a hidden side could be a longer side of the box");
