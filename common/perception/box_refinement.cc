@@ -59,8 +59,7 @@ FaceFrame MakeFaceFrame(const Eigen::Isometry3d& camera_T_box, const BoxDims& di
 // corner's points are in two bands). Per side: the points on the plane,
 // the points in front of it (an occluder) and where every pixel's ray meets
 // the plane (what a fully seen face would give: the reference for point
-// densities; its n is 1 where that pixel returned a point on the plane, 0
-// where it returned none or one off the plane).
+// densities; its n says what that pixel returned: GridReturn).
 struct FacePoints {
   // The points on the plane >= 1 cm inside every side, as their count and
   // the sums of their coordinates and products (all the plane fit needs).
@@ -69,6 +68,14 @@ struct FacePoints {
   Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
   std::array<std::vector<FacePoint>, 4> on_plane, front, grid;  // +a, -a, +b, -b bands
 };
+
+// What a pixel of the ray-plane grid returned, as its FacePoint's n.
+namespace GridReturn {
+constexpr double kOnPlane = 1.0;
+constexpr double kBehind = -1.0;  // a point behind the plane: it is not there
+constexpr double kInFront = 0.5;  // a point in front of it, hiding it
+constexpr double kNothing = 0.0;  // no return
+}  // namespace GridReturn
 
 // Side order +a, -a, +b, -b, as RefinementResult::sides.
 int SideIndex(bool along_a, double sign) { return (along_a ? 0 : 2) + (sign > 0.0 ? 0 : 1); }
@@ -150,9 +157,10 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
         const float z = zrow[u];
         const double off = z * n_r - n_c;  // NaN where no return
         const bool hit = !std::isnan(z) && std::abs(off) <= plane_tol;
-        // 1: a point on the plane; -1: one behind it (the plane is not
-        // there); 0.5: one in front of it (hiding it); 0: no return.
-        const double n = hit ? 1.0 : off < -plane_tol ? -1.0 : off > plane_tol ? 0.5 : 0.0;
+        const double n = hit                ? GridReturn::kOnPlane
+                         : off < -plane_tol ? GridReturn::kBehind
+                         : off > plane_tol  ? GridReturn::kInFront
+                                            : GridReturn::kNothing;
         to_sides(FacePoint{qa, qb, n}, out.grid);
       }
     };
@@ -239,8 +247,8 @@ struct SideMeasure {
   // kSeam only: found past the symmetric search window, in its outward
   // extension (see OutwardSeamsNeedEverySide).
   bool outward_seam = false;
-  // kUnknown only: most pixels just inside the side see past the plane
-  // (behind where the face would be): the face ends before the side.
+  // kUnknown only: enough of the pixels just inside the side see behind the
+  // plane (RefinementOptions::seen_through_share): the face ends before it.
   bool seen_through = false;
   // kContinues only: where the face's points end within the band.
   bool rim = false;
@@ -303,7 +311,8 @@ class SeamScan {
     }
     for (const FacePoint& p : grid) {  // where pixels meet the plane, same band
       double across, along;
-      if (band(p, &across, &along)) expected_.push_back({across, along, p.n == 1.0 ? 1.0 : 0.0});
+      if (band(p, &across, &along))
+        expected_.push_back({across, along, p.n == GridReturn::kOnPlane ? 1.0 : 0.0});
     }
     BucketSort(&expected_, -reach, reach, [](const Pixel& e) { return e.across; });
     BucketSort(&rows, -reach, reach, [](const Row& r) { return r.across; });
@@ -608,8 +617,8 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
         continue;
       }
       ++pixels;
-      behind += g.n < 0.0;
-      hidden += g.n == 0.5;
+      behind += g.n == GridReturn::kBehind;
+      hidden += g.n == GridReturn::kInFront;
     }
     m.seen_through = o.seen_through_share > 0.0 && behind >= 10 &&
                      behind >= o.seen_through_share * (pixels - hidden);

@@ -201,7 +201,7 @@ double SeamSupport(const DepthImage& image, const PlaneRectangle& rect, const Fa
 
 namespace {
 
-// What one patch proposes (ProposeFromFaces, the patches' in order).
+// What one patch proposes (ProposeFromFaces gathers them in patch order).
 struct PatchProposals {
   std::vector<Eigen::Isometry3d> poses;
   std::vector<DeclinedCandidate> declined;
@@ -216,7 +216,7 @@ void ProposeFromPatch(const DepthImage& image, const PlanarPatches& patches, siz
   std::sort(sorted.begin(), sorted.end());
   const double smallest_face = sorted[0] * sorted[1];
   const double cos_view = std::cos(o.max_view_angle_deg * std::numbers::pi / 180.0);
-  auto anchor_and_split = [&](size_t id, const PlaneRectangle& rect, double cell_m) {
+  auto anchor_and_split = [&](const PlaneRectangle& rect, double cell_m) {
     const std::vector<Eigen::Isometry3d> faces =
         AnchoredFaces(patches.patches[id], rect, cell_m, image.camera, dims, o.anchored);
     out.poses.insert(out.poses.end(), faces.begin(), faces.end());
@@ -224,161 +224,155 @@ void ProposeFromPatch(const DepthImage& image, const PlanarPatches& patches, siz
         SeamSplitFaces(image, patches, static_cast<int>(id), rect, dims, o.seam_split);
     out.poses.insert(out.poses.end(), split.begin(), split.end());
   };
-  {
-    const PlanarPatch& patch = patches.patches[id];
-    const double cell_m = patch.centroid.z() / image.camera.fx * patches.step_px;
-    const double area = patch.points.size() * cell_m * cell_m;
-    if (area < 0.5 * smallest_face) return;
-    if (patch.normal.dot(-patch.centroid.normalized()) < cos_view) return;
-    const PlaneRectangle rect = OutlineRectangle(patch);
-    // An outline cut by the image border says nothing about where a layer
-    // ends. One no bigger than a face may still be that face whole (a box
-    // near the edge of the view, its patch within a window of the border):
-    // it proposes faces of the box on it, never a layer, and the judge
-    // decides whether every side was seen (AcceptanceOptions).
-    const double largest_side = sorted[2] + o.size_tolerance_m;
-    const bool at_border = patch.touches_border;
-    // One bigger than a face (a layer, a heap's top) may still have corners
-    // inside the view (faces anchored there) and seams across it (faces
-    // split out along them).
-    if (at_border &&
-        (!o.propose_at_border || rect.width > largest_side || rect.height > largest_side)) {
-      if (o.propose_at_border) anchor_and_split(id, rect, cell_m);
-      return;
-    }
-    // A patch filling little of its outline is no face or layer (a floor
-    // around things, an L of two boxes' sides).
-    if (area < 0.5 * rect.width * rect.height) return;
-    // A tile is proposed only where the patch is (a layer can be notched
-    // where boxes were taken).
-    auto on_patch = [&](const Eigen::Isometry3d& pose, const FaceTiling& t) {
-      const Eigen::Vector3d face_centre =
-          pose.translation() + 0.5 * dims[t.normal_axis] * rect.normal;
-      if (face_centre.z() <= 0.05) return false;
-      const Eigen::Vector2d px = Project(image.camera, face_centre);
-      const int u = static_cast<int>(std::lround(px.x())),
-                v = static_cast<int>(std::lround(px.y()));
-      for (int dv = -1; dv <= 1; ++dv) {
-        for (int du = -1; du <= 1; ++du) {
-          if (patches.PatchAt(u + du * patches.step_px, v + dv * patches.step_px) ==
-              static_cast<int>(id)) {
-            return true;
-          }
+  const PlanarPatch& patch = patches.patches[id];
+  const double cell_m = patch.centroid.z() / image.camera.fx * patches.step_px;
+  const double area = patch.points.size() * cell_m * cell_m;
+  if (area < 0.5 * smallest_face) return;
+  if (patch.normal.dot(-patch.centroid.normalized()) < cos_view) return;
+  const PlaneRectangle rect = OutlineRectangle(patch);
+  // An outline cut by the image border says nothing about where a layer
+  // ends. One no bigger than a face may still be that face whole (a box
+  // near the edge of the view, its patch within a window of the border):
+  // it proposes faces of the box on it, never a layer, and the judge
+  // decides whether every side was seen (AcceptanceOptions).
+  const double largest_side = sorted[2] + o.size_tolerance_m;
+  const bool at_border = patch.touches_border;
+  // One bigger than a face (a layer, a heap's top) may still have corners
+  // inside the view (faces anchored there) and seams across it (faces
+  // split out along them).
+  if (at_border &&
+      (!o.propose_at_border || rect.width > largest_side || rect.height > largest_side)) {
+    if (o.propose_at_border) anchor_and_split(rect, cell_m);
+    return;
+  }
+  // A patch filling little of its outline is no face or layer (a floor
+  // around things, an L of two boxes' sides).
+  if (area < 0.5 * rect.width * rect.height) return;
+  // A tile is proposed only where the patch is (a layer can be notched
+  // where boxes were taken).
+  auto on_patch = [&](const Eigen::Isometry3d& pose, const FaceTiling& t) {
+    const Eigen::Vector3d face_centre =
+        pose.translation() + 0.5 * dims[t.normal_axis] * rect.normal;
+    if (face_centre.z() <= 0.05) return false;
+    const Eigen::Vector2d px = Project(image.camera, face_centre);
+    const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+    for (int dv = -1; dv <= 1; ++dv) {
+      for (int du = -1; du <= 1; ++du) {
+        if (patches.PatchAt(u + du * patches.step_px, v + dv * patches.step_px) ==
+            static_cast<int>(id)) {
+          return true;
         }
       }
-      return false;
-    };
-    auto propose = [&](const FaceTiling& t) {
+    }
+    return false;
+  };
+  auto propose = [&](const FaceTiling& t) {
+    for (const Eigen::Isometry3d& pose : TilePoses(rect, t, dims)) {
+      if (on_patch(pose, t)) out.poses.push_back(pose);
+    }
+  };
+  // The tiles a box on this patch may be (every tile of the tilings in
+  // play, on the patch or not: a notch is where a box was taken).
+  auto in_play = [&](std::initializer_list<FaceTiling> in) {
+    if (at_border) return;
+    // Fill: the patch's area over that of the tiles on it (a layer with
+    // boxes taken away is still full where it is); the least of the
+    // tilings in play.
+    LayerTiles layer{
+        static_cast<int>(id), std::numeric_limits<double>::max(), patch.normal, patch.centroid, {}};
+    for (const FaceTiling& t : in) {
+      int present = 0;
       for (const Eigen::Isometry3d& pose : TilePoses(rect, t, dims)) {
-        if (on_patch(pose, t)) out.poses.push_back(pose);
+        layer.tiles.push_back(pose);
+        present += on_patch(pose, t);
       }
-    };
-    // The tiles a box on this patch may be (every tile of the tilings in
-    // play, on the patch or not: a notch is where a box was taken).
-    auto in_play = [&](std::initializer_list<FaceTiling> in) {
-      if (at_border) return;
-      // Fill: the patch's area over that of the tiles on it (a layer with
-      // boxes taken away is still full where it is); the least of the
-      // tilings in play.
-      LayerTiles layer{static_cast<int>(id),
-                       std::numeric_limits<double>::max(),
-                       patch.normal,
-                       patch.centroid,
-                       {}};
-      for (const FaceTiling& t : in) {
-        int present = 0;
-        for (const Eigen::Isometry3d& pose : TilePoses(rect, t, dims)) {
-          layer.tiles.push_back(pose);
-          present += on_patch(pose, t);
-        }
-        const double tile_area = dims[t.axis_u] * dims[t.axis_v];
-        layer.fill = std::min(layer.fill, present > 0 ? area / (present * tile_area) : 0.0);
-      }
-      out.layers.push_back(std::move(layer));
-    };
-    const std::vector<FaceTiling> tilings = TilingsOf(rect.width, rect.height, dims, o);
-    if (tilings.empty()) {
-      // For the layer check only (nothing is proposed from it): an outline
-      // a little too big to tile (its rim taken in, noise at a closer
-      // range) still makes a layer with twice the tolerance, when one
-      // tiling has the fewest tiles; an anchor must confirm it (detector).
-      FaceProposalOptions loose = o;
-      loose.size_tolerance_m = 2.0 * o.size_tolerance_m;
-      const std::vector<FaceTiling> near = TilingsOf(rect.width, rect.height, dims, loose);
-      if (near.size() == 1 || (near.size() > 1 && near[0].tiles() < near[1].tiles())) {
-        in_play({near[0]});
-      }
-      // Not a whole number of faces (part of it hidden or out of view): a
-      // face in each corner of the outline, for each way one fits in it;
-      // only for an outline about one face in size (a bigger one is a
-      // floor, a wall, a layer cut by the image border).
-      if (rect.width > largest_side || rect.height > largest_side) {
-        anchor_and_split(id, rect, cell_m);
-        return;
-      }
-      for (int n = 0; n < 3; ++n) {
-        const int a = (n + 1) % 3, b = (n + 2) % 3;
-        for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {
-          const FaceTiling t{n, su, sv, 1, 1};
-          if (dims[su] > rect.width + o.size_tolerance_m ||
-              dims[sv] > rect.height + o.size_tolerance_m) {
-            // Smaller than the face but most of it: a face whose rim the
-            // segmentation took in (a stereo camera's noise, rounded edges)
-            // is centred on its outline.
-            if (o.min_eroded_share > 0.0 && rect.width >= o.min_eroded_share * dims[su] &&
-                rect.height >= o.min_eroded_share * dims[sv]) {
-              const Eigen::Isometry3d pose = TilePose(rect, t, dims, 0.0, 0.0);
-              if (on_patch(pose, t)) out.poses.push_back(pose);
-            }
-            continue;
+      const double tile_area = dims[t.axis_u] * dims[t.axis_v];
+      layer.fill = std::min(layer.fill, present > 0 ? area / (present * tile_area) : 0.0);
+    }
+    out.layers.push_back(std::move(layer));
+  };
+  const std::vector<FaceTiling> tilings = TilingsOf(rect.width, rect.height, dims, o);
+  if (tilings.empty()) {
+    // For the layer check only (nothing is proposed from it): an outline
+    // a little too big to tile (its rim taken in, noise at a closer
+    // range) still makes a layer with twice the tolerance, when one
+    // tiling has the fewest tiles; an anchor must confirm it (detector).
+    FaceProposalOptions loose = o;
+    loose.size_tolerance_m = 2.0 * o.size_tolerance_m;
+    const std::vector<FaceTiling> near = TilingsOf(rect.width, rect.height, dims, loose);
+    if (near.size() == 1 || (near.size() > 1 && near[0].tiles() < near[1].tiles())) {
+      in_play({near[0]});
+    }
+    // Not a whole number of faces (part of it hidden or out of view): a
+    // face in each corner of the outline, for each way one fits in it;
+    // only for an outline about one face in size (a bigger one is a
+    // floor, a wall, a layer cut by the image border).
+    if (rect.width > largest_side || rect.height > largest_side) {
+      anchor_and_split(rect, cell_m);
+      return;
+    }
+    for (int n = 0; n < 3; ++n) {
+      const int a = (n + 1) % 3, b = (n + 2) % 3;
+      for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {
+        const FaceTiling t{n, su, sv, 1, 1};
+        if (dims[su] > rect.width + o.size_tolerance_m ||
+            dims[sv] > rect.height + o.size_tolerance_m) {
+          // Smaller than the face but most of it: a face whose rim the
+          // segmentation took in (a stereo camera's noise, rounded edges)
+          // is centred on its outline.
+          if (o.min_eroded_share > 0.0 && rect.width >= o.min_eroded_share * dims[su] &&
+              rect.height >= o.min_eroded_share * dims[sv]) {
+            const Eigen::Isometry3d pose = TilePose(rect, t, dims, 0.0, 0.0);
+            if (on_patch(pose, t)) out.poses.push_back(pose);
           }
-          for (double cu : {-1.0, 1.0}) {
-            for (double cv : {-1.0, 1.0}) {
-              const Eigen::Isometry3d pose =
-                  TilePose(rect, t, dims, cu * 0.5 * (rect.width - dims[su]),
-                           cv * 0.5 * (rect.height - dims[sv]));
-              if (on_patch(pose, t)) out.poses.push_back(pose);
-            }
+          continue;
+        }
+        for (double cu : {-1.0, 1.0}) {
+          for (double cv : {-1.0, 1.0}) {
+            const Eigen::Isometry3d pose =
+                TilePose(rect, t, dims, cu * 0.5 * (rect.width - dims[su]),
+                         cv * 0.5 * (rect.height - dims[sv]));
+            if (on_patch(pose, t)) out.poses.push_back(pose);
           }
         }
       }
-      return;
     }
-    if (tilings.size() == 1) {
-      propose(tilings[0]);
-      in_play({tilings[0]});
-      return;
-    }
-    // Several tilings fit: seam cues first, then the fewest boxes.
-    std::vector<double> support(tilings.size(), 0.0);
+    return;
+  }
+  if (tilings.size() == 1) {
+    propose(tilings[0]);
+    in_play({tilings[0]});
+    return;
+  }
+  // Several tilings fit: seam cues first, then the fewest boxes.
+  std::vector<double> support(tilings.size(), 0.0);
+  for (size_t i = 0; i < tilings.size(); ++i) {
+    support[i] = SeamSupport(image, rect, tilings[i], dims, o.seams);
+  }
+  const size_t best = std::max_element(support.begin(), support.end()) - support.begin();
+  int chosen = -1;
+  if (support[best] >= o.min_seam_support) {
+    bool alone = true;
     for (size_t i = 0; i < tilings.size(); ++i) {
-      support[i] = SeamSupport(image, rect, tilings[i], dims, o.seams);
+      if (i != best && support[i] > support[best] - o.seam_support_margin) alone = false;
     }
-    const size_t best = std::max_element(support.begin(), support.end()) - support.begin();
-    int chosen = -1;
-    if (support[best] >= o.min_seam_support) {
-      bool alone = true;
-      for (size_t i = 0; i < tilings.size(); ++i) {
-        if (i != best && support[i] > support[best] - o.seam_support_margin) alone = false;
-      }
-      if (alone) chosen = static_cast<int>(best);
-    } else if (tilings[0].tiles() < tilings[1].tiles()) {
-      chosen = 0;
-    }
-    if (chosen >= 0) {
-      propose(tilings[chosen]);
-      in_play({tilings[chosen]});
-      return;
-    }
-    in_play({tilings[0], tilings[1]});
-    for (size_t i = 0; i < tilings.size() && i < 2; ++i) {
-      DeclinedCandidate d;
-      d.camera_T_box = TilePoses(rect, tilings[i], dims).front();
-      d.reason = absl::StrFormat(
-          "face %.3f x %.3f m tiles two ways (%s, or %s) and no seam cue decides", rect.width,
-          rect.height, Describe(tilings[0], dims), Describe(tilings[1], dims));
-      out.declined.push_back(d);
-    }
+    if (alone) chosen = static_cast<int>(best);
+  } else if (tilings[0].tiles() < tilings[1].tiles()) {
+    chosen = 0;
+  }
+  if (chosen >= 0) {
+    propose(tilings[chosen]);
+    in_play({tilings[chosen]});
+    return;
+  }
+  in_play({tilings[0], tilings[1]});
+  for (size_t i = 0; i < tilings.size() && i < 2; ++i) {
+    DeclinedCandidate d;
+    d.camera_T_box = TilePoses(rect, tilings[i], dims).front();
+    d.reason = absl::StrFormat(
+        "face %.3f x %.3f m tiles two ways (%s, or %s) and no seam cue decides", rect.width,
+        rect.height, Describe(tilings[0], dims), Describe(tilings[1], dims));
+    out.declined.push_back(d);
   }
 }
 
