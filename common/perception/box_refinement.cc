@@ -59,7 +59,7 @@ FaceFrame MakeFaceFrame(const Eigen::Isometry3d& camera_T_box, const BoxDims& di
 // corner's points are in two bands). Per side: the points on the plane,
 // the points in front of it (an occluder) and where every pixel's ray meets
 // the plane (what a fully seen face would give: the reference for point
-// densities; its n says what that pixel returned: GridReturn).
+// densities; its n says what that pixel returned: grid_return).
 struct FacePoints {
   // The points on the plane >= 1 cm inside every side, as their count and
   // the sums of their coordinates and products (all the plane fit needs).
@@ -70,12 +70,12 @@ struct FacePoints {
 };
 
 // What a pixel of the ray-plane grid returned, as its FacePoint's n.
-namespace GridReturn {
+namespace grid_return {
 constexpr double kOnPlane = 1.0;
 constexpr double kBehind = -1.0;  // a point behind the plane: it is not there
 constexpr double kInFront = 0.5;  // a point in front of it, hiding it
 constexpr double kNothing = 0.0;  // no return
-}  // namespace GridReturn
+}  // namespace grid_return
 
 // Side order +a, -a, +b, -b, as RefinementResult::sides.
 int SideIndex(bool along_a, double sign) { return (along_a ? 0 : 2) + (sign > 0.0 ? 0 : 1); }
@@ -157,10 +157,10 @@ void CollectFacePoints(const DepthImage& depth, const FaceFrame& f, double margi
         const float z = zrow[u];
         const double off = z * n_r - n_c;  // NaN where no return
         const bool hit = !std::isnan(z) && std::abs(off) <= plane_tol;
-        const double n = hit                ? GridReturn::kOnPlane
-                         : off < -plane_tol ? GridReturn::kBehind
-                         : off > plane_tol  ? GridReturn::kInFront
-                                            : GridReturn::kNothing;
+        const double n = hit                ? grid_return::kOnPlane
+                         : off < -plane_tol ? grid_return::kBehind
+                         : off > plane_tol  ? grid_return::kInFront
+                                            : grid_return::kNothing;
         to_sides(FacePoint{qa, qb, n}, out.grid);
       }
     };
@@ -312,7 +312,7 @@ class SeamScan {
     for (const FacePoint& p : grid) {  // where pixels meet the plane, same band
       double across, along;
       if (band(p, &across, &along))
-        expected_.push_back({across, along, p.n == GridReturn::kOnPlane ? 1.0 : 0.0});
+        expected_.push_back({across, along, p.n == grid_return::kOnPlane ? 1.0 : 0.0});
     }
     BucketSort(&expected_, -reach, reach, [](const Pixel& e) { return e.across; });
     BucketSort(&rows, -reach, reach, [](const Row& r) { return r.across; });
@@ -617,8 +617,8 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
         continue;
       }
       ++pixels;
-      behind += g.n == GridReturn::kBehind;
-      hidden += g.n == GridReturn::kInFront;
+      behind += g.n == grid_return::kBehind;
+      hidden += g.n == grid_return::kInFront;
     }
     m.seen_through = o.seen_through_share > 0.0 && behind >= 10 &&
                      behind >= o.seen_through_share * (pixels - hidden);
