@@ -136,6 +136,9 @@ constexpr char kHelp[] =
     "                       other sides end it and it is seen to the border longer\n"
     "                       than any shorter side of the box, over 60% of its length\n"
     "                       (true)\n"
+    "  --score_in_view BOOL a box's score is its support times the share of its\n"
+    "                       outline in the image: boxes partly out of view rank\n"
+    "                       below those wholly in view (true)\n"
     "  --retry_declined BOOL a pose refined and declined is judged once more when\n"
     "                       proposed again from another start (true)\n"
     "  --patch_window N     planar patches: a cell's normal from (2N+1)^2 cells of 4 px\n"
@@ -190,6 +193,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("border_faces", &options.faces.propose_at_border),
         args.SetInt("leaving_view", &options.acceptance.leaving_view_free_axes),
         args.SetBool("out_of_view", &options.acceptance.face_may_run_out_of_view),
+        args.SetBool("score_in_view", &options.score_in_view),
         args.SetBool("kept_seams", &options.acceptance.kept_box_ends_side),
         args.SetBool("pairs", &options.acceptance.pairs_end_each_other),
         args.SetDouble("seen_through", &options.refinement.seen_through_share),
@@ -312,6 +316,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "border_faces",
                                                        "leaving_view",
                                                        "out_of_view",
+                                                       "score_in_view",
                                                        "kept_seams",
                                                        "pairs",
                                                        "seen_through",

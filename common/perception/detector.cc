@@ -20,6 +20,7 @@
 #include "common/perception/internal/hypothesis_judge.h"
 #include "common/perception/internal/kept_neighbours.h"
 #include "common/perception/internal/parallel.h"
+#include "common/perception/internal/view_share.h"
 #include "common/perception/neighbour_hypotheses.h"
 #include "common/validation/range_check.h"
 
@@ -922,6 +923,11 @@ absl::Status JudgeAndKeep(const PreparedFrame& frame, const SegmentGroups& group
   }
   AlignToLayerPlanes(frame.depth, options.box, options.layer_plane, &det->boxes);
   if (absl::Status s = cancel.Check("the judging of hypotheses"); !s.ok()) return s;
+  if (options.score_in_view) {
+    for (DetectedBox& box : det->boxes) {
+      box.score *= internal::BoxViewShare(frame.depth.camera, box.camera_T_box, options.box);
+    }
+  }
   std::stable_sort(det->boxes.begin(), det->boxes.end(),
                    [](const DetectedBox& a, const DetectedBox& b) { return a.score > b.score; });
   det->hypotheses = judge.stats();

@@ -204,6 +204,13 @@ struct DetectorOptions {
   // whole neighbourhood at full resolution, and the boxes are refined and
   // judged on every pixel. 0 keeps edge_points.lattice_px as it is. Pixels.
   double edge_lattice_radius_px = 5.0;
+  // A returned box's score is the judge's (its faces' support) times the
+  // share of its outline in the image (internal::BoxViewShare): a box
+  // partly out of view ranks below one wholly in view that the depth
+  // supports as well. What lies out of view cannot be checked for what
+  // touches the box, and a grasp planned on it is a guess. Which boxes are
+  // returned does not change. False reports the judge's score.
+  bool score_in_view = true;
   // Declined hypotheses reported per frame (the strongest). Count, >= 0.
   int max_declined = 8;
   // A hypothesis refined and declined may be proposed once more from

@@ -16,6 +16,7 @@
 
 #include "common/box/box_models.h"
 #include "common/perception/box_pose.h"
+#include "common/perception/internal/view_share.h"
 #include "common/perception/pose_error.h"
 #include "tests/support/scene_generator.h"
 
@@ -302,6 +303,50 @@ TEST(DetectorTest, UnorganizedCloudOfAFrameFindsTheSameBoxes) {
   const Tally t = Evaluate(out, *det, dims, 0.010, 5.0);
   EXPECT_EQ(t.found, 3) << Join(t.problems);
   EXPECT_EQ(t.correct, t.returned) << Join(t.problems);
+}
+
+// Two cartons lying flat, one in the middle of the view and one with a
+// quarter of its length past the image's right edge: both are returned, and
+// the one partly out of view ranks second, its score scaled by its share in
+// view (DetectorOptions::score_in_view); which boxes are returned does not
+// change.
+TEST(DetectorTest, ABoxPartlyOutOfViewRanksBelowOneInView) {
+  const BoxDims dims = Model("carton_s");
+  Scene scene;
+  scene.world_T_camera = LookAtCamera({0.0, 0.0, 0.0}, 1.3, 0.0, 0.0, 0.0);
+  const double half_width = (scene.camera.width / 2.0) / scene.camera.fx * (1.3 - dims.h);
+  for (const double x : {-0.1, half_width + 0.075 - dims.l / 2.0}) {
+    SceneBox box;
+    box.dims = dims;
+    box.world_T_box.translation() = Eigen::Vector3d(x, 0.0, dims.h / 2.0);
+    scene.boxes.push_back(box);
+  }
+  const RenderedScene out = Render(scene, NoiseOptions{});
+  DetectorOptions plain = Options(dims);
+  plain.score_in_view = false;
+  const absl::StatusOr<Detection> a = DetectBoxes(out.cloud, plain);
+  const absl::StatusOr<Detection> b = DetectBoxes(out.cloud, Options(dims));
+  ASSERT_TRUE(a.ok() && b.ok());
+  ASSERT_EQ(a->boxes.size(), 2u);
+  ASSERT_EQ(b->boxes.size(), 2u);
+  const Tally t = Evaluate(out, *b, dims, 0.010, 5.0);
+  EXPECT_EQ(t.correct, 2) << Join(t.problems);
+  // b's first box is the one in view; scores are a's times the share in view.
+  const Eigen::Vector3d in_view = out.boxes[0].camera_T_box.translation();
+  EXPECT_LT((b->boxes[0].camera_T_box.translation() - in_view).norm(), 0.02);
+  EXPECT_GT((b->boxes[1].camera_T_box.translation() - in_view).norm(), 0.2);
+  for (const DetectedBox& box : b->boxes) {
+    const auto same = std::find_if(a->boxes.begin(), a->boxes.end(), [&](const DetectedBox& o) {
+      return o.camera_T_box.isApprox(box.camera_T_box, 1e-12);
+    });
+    ASSERT_NE(same, a->boxes.end());
+    const double share = internal::BoxViewShare(out.camera, box.camera_T_box, dims);
+    EXPECT_NEAR(box.score, same->score * share, 1e-6);  // its camera is fitted to the cloud
+  }
+  EXPECT_DOUBLE_EQ(internal::BoxViewShare(out.camera, b->boxes[0].camera_T_box, dims), 1.0);
+  const double edge_share = internal::BoxViewShare(out.camera, b->boxes[1].camera_T_box, dims);
+  EXPECT_GT(edge_share, 0.6);
+  EXPECT_LT(edge_share, 0.9);
 }
 
 TEST(DetectorTest, SameInputSameOutputWithAnyThreadCount) {
