@@ -95,6 +95,8 @@ constexpr char kHelp[] =
     "                       both sides proposes the face centred on it (0.65; 0: off)\n"
     "  --merge_patches N    planar patches within N cells of each other on one plane\n"
     "                       are one (a face noise broke up; 2; 0: no merging)\n"
+    "  --merged_pieces BOOL ... and the pieces so merged propose their faces too (two\n"
+    "                       boxes' faces on one plane, a shadow between them; true)\n"
     "  --tile_uncued BOOL   a face that runs on flat with no seam anywhere is a tile of\n"
     "                       its layer when the layer tiles (false: a laptop lid is not\n"
     "                       boxes; true for cells that see only layers of known boxes)\n"
@@ -200,6 +202,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetInt("empty_window", &options.empty_frame_window_cells),
         args.SetBool("anchored_faces", &options.faces.anchored.enabled),
         args.SetBool("seam_split", &options.faces.seam_split.enabled),
+        args.SetBool("merged_pieces", &options.faces.propose_merged_pieces),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
         args.SetDouble("end_on_flat", &options.refinement.end_on_flat_shift_m),
         args.SetDouble("slat_gap", &options.refinement.slat_gap_max_m),
@@ -323,6 +326,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "empty_window",
                                                        "anchored_faces",
                                                        "seam_split",
+                                                       "merged_pieces",
                                                        "rim_sides",
                                                        "end_on_flat",
                                                        "slat_gap",

@@ -382,25 +382,34 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
                                const FaceProposalOptions& o, const CancelToken* cancel,
                                internal::SharedLoops* helpers) {
   FaceProposals out;
-  out.patches = SegmentPlanarPatches(image, o.patches);
+  PlanarPatches pieces;
+  out.patches = SegmentPlanarPatches(image, o.patches, o.propose_merged_pieces ? &pieces : nullptr);
   const PlanarPatches& patches = out.patches;
   out.num_patches = static_cast<int>(patches.patches.size());
-  // Patch by patch, each into its own slot (with helpers, in any order on
-  // any thread), gathered in patch order: the same proposals either way.
-  std::vector<PatchProposals> per_patch(patches.patches.size());
+  // Patch by patch, then piece by piece, each into its own slot (with
+  // helpers, in any order on any thread), gathered in that order: the same
+  // proposals either way.
+  const int n = static_cast<int>(patches.patches.size());
+  std::vector<PatchProposals> per_patch(n + pieces.patches.size());
   auto propose = [&](int begin, int end) {
     for (int id = begin; id < end && !StopRequested(cancel); ++id) {
-      ProposeFromPatch(image, patches, id, dims, o, &per_patch[id]);
+      if (id < n) {
+        ProposeFromPatch(image, patches, id, dims, o, &per_patch[id]);
+      } else {
+        ProposeFromPatch(image, pieces, id - n, dims, o, &per_patch[id]);
+      }
     }
   };
-  const int n = static_cast<int>(per_patch.size());
+  const int all = static_cast<int>(per_patch.size());
   if (helpers != nullptr) {
-    helpers->Run(n, 1, propose);
+    helpers->Run(all, 1, propose);
   } else {
-    propose(0, n);
+    propose(0, all);
   }
-  for (PatchProposals& p : per_patch) {
+  for (int id = 0; id < all; ++id) {
+    PatchProposals& p = per_patch[id];
     out.poses.insert(out.poses.end(), p.poses.begin(), p.poses.end());
+    if (id >= n) continue;  // a piece: its poses only
     out.declined.insert(out.declined.end(), p.declined.begin(), p.declined.end());
     for (LayerTiles& l : p.layers) out.layers.push_back(std::move(l));
   }

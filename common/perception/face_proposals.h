@@ -40,6 +40,12 @@ struct FaceProposalOptions {
   // of missing returns or grooves, parallel to its outline);
   // seam_split_faces.h.
   SeamSplitOptions seam_split;
+  // The patches that merging joined with others (PlanarPatchOptions::
+  // merge_gap_cells) propose their faces too, each as it was before: two
+  // boxes' faces on one plane with a shadow between them merge into a patch
+  // that tiles as neither. Their tilings propose poses only (no layer, no
+  // declined tiling). False: the merged patches alone.
+  bool propose_merged_pieces = true;
   // A run of n faces fits an outline side when it is n sizes plus 0 to
   // (n - 1) max_gap_m long, within size_tolerance_m. Metres.
   double size_tolerance_m = 0.02;

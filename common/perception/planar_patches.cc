@@ -51,7 +51,7 @@ int Root(std::vector<int>& parent, int i) {
 // refitted before it is compared again.
 template <typename Tolerance>
 void MergeCoplanarPatches(const PlanarPatchOptions& o, const Tolerance& tolerance,
-                          PlanarPatches* out) {
+                          PlanarPatches* out, PlanarPatches* pieces) {
   const int n = static_cast<int>(out->patches.size());
   if (n < 2) return;
   const int W = out->cells_wide, H = out->cells_high, g = o.merge_gap_cells;
@@ -122,6 +122,21 @@ void MergeCoplanarPatches(const PlanarPatchOptions& o, const Tolerance& toleranc
   // points.
   std::vector<int> members(n, 0);
   for (int i = 0; i < n; ++i) ++members[Root(parent, i)];
+  if (pieces != nullptr) {
+    pieces->cells_wide = W;
+    pieces->cells_high = H;
+    pieces->step_px = out->step_px;
+    pieces->label.assign(out->label.size(), -1);
+    std::vector<int> piece_id(n, -1);
+    for (int i = 0; i < n; ++i) {
+      if (members[Root(parent, i)] == 1) continue;
+      piece_id[i] = static_cast<int>(pieces->patches.size());
+      pieces->patches.push_back(out->patches[i]);
+    }
+    for (size_t c = 0; c < out->label.size(); ++c) {
+      if (out->label[c] >= 0) pieces->label[c] = piece_id[out->label[c]];
+    }
+  }
   std::vector<int> new_id(n, -1);
   std::vector<PlanarPatch> patches;
   for (int i = 0; i < n; ++i) {
@@ -177,8 +192,10 @@ absl::Status PlanarPatchOptions::Validate() const {
   return absl::OkStatus();
 }
 
-PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOptions& o) {
+PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOptions& o,
+                                   PlanarPatches* merged_pieces) {
   PlanarPatches out;
+  if (merged_pieces != nullptr) *merged_pieces = PlanarPatches();
   const CameraIntrinsics& k = depth.camera;
   const int s = o.step_px;
   const int W = k.width / s, H = k.height / s;
@@ -346,7 +363,7 @@ PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOpt
     out.patches.push_back(std::move(patch));
   }
   for (int& l : out.label) l = std::max(l, -1);
-  if (o.merge_gap_cells > 0) MergeCoplanarPatches(o, tolerance, &out);
+  if (o.merge_gap_cells > 0) MergeCoplanarPatches(o, tolerance, &out, merged_pieces);
   return out;
 }
 

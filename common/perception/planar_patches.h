@@ -66,6 +66,12 @@ struct PlanarPatches {
   }
 };
 
-PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOptions& options);
+// With `merged_pieces` (may be null): the patches that merging
+// (merge_gap_cells) joined with others, each as it was before, with a label
+// map of their own (-1 outside them). Two boxes' faces on one plane with a
+// shadow between them merge into a patch that is neither; their pieces
+// still are.
+PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOptions& options,
+                                   PlanarPatches* merged_pieces = nullptr);
 
 }  // namespace cornerpose

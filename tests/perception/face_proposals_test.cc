@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/perception/camera_model.h"
 #include "common/perception/internal/parallel.h"
 #include "common/perception/planar_patches.h"
 #include "common/perception/seam_cues.h"
@@ -246,6 +247,73 @@ TEST(FaceProposalsTest, PatchesSharedWithAHelperProposeTheSame) {
     EXPECT_EQ(shared.layers[i].tiles.size(), alone.layers[i].tiles.size());
   }
   EXPECT_EQ(shared.declined.size(), alone.declined.size());
+}
+
+// Two carton tops on one plane, 1.2 m below the camera, a shadow of a few
+// pixels between them, one turned 25 degrees: merging (merge_gap_cells)
+// joins them into one patch whose outline tiles as neither. The pieces
+// propose each carton where it is (FaceProposalOptions::
+// propose_merged_pieces); the merged patch alone proposes none of the
+// turned one.
+TEST(FaceProposalsTest, FacesMergedAcrossAGapAreProposedFromTheirPieces) {
+  struct Top {
+    Eigen::Vector2d centre;
+    double yaw_deg;
+    bool Contains(double x, double y, double margin = 0.0) const {
+      const double c = std::cos(yaw_deg * M_PI / 180), s = std::sin(yaw_deg * M_PI / 180);
+      const double dx = x - centre.x(), dy = y - centre.y();
+      return std::abs(c * dx + s * dy) <= kCarton.l / 2 + margin &&
+             std::abs(-s * dx + c * dy) <= kCarton.b / 2 + margin;
+    }
+  };
+  const Top tops[2] = {{{-0.17, 0.0}, 0.0}, {{0.17, 0.06}, 25.0}};
+  DepthImage image;
+  const CameraIntrinsics& k = image.camera;
+  image.z.assign(static_cast<size_t>(k.width) * k.height, 0.0f);
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const Eigen::Vector3d ray = PixelRay(k, u, v);
+      const double x = ray.x() * kTop, y = ray.y() * kTop;
+      const bool on_top = tops[0].Contains(x, y) || tops[1].Contains(x, y);
+      // A shadow 3 cm wide around each (a Kinect's), the floor beyond.
+      const bool shadow = tops[0].Contains(x, y, 0.03) || tops[1].Contains(x, y, 0.03);
+      image.z[static_cast<size_t>(v) * k.width + u] = on_top ? static_cast<float>(kTop)
+                                                      : shadow
+                                                          ? std::numeric_limits<float>::quiet_NaN()
+                                                          : static_cast<float>(kFloor);
+    }
+  }
+  FaceProposalOptions o;
+  PlanarPatches pieces;
+  const PlanarPatches merged = SegmentPlanarPatches(image, o.patches, &pieces);
+  auto at = [&](const PlanarPatches& p, const Top& t) {
+    const Eigen::Vector2d px = Project(k, Eigen::Vector3d(t.centre.x(), t.centre.y(), kTop));
+    return p.PatchAt(static_cast<int>(px.x()), static_cast<int>(px.y()));
+  };
+  ASSERT_GE(at(merged, tops[0]), 0);
+  ASSERT_EQ(at(merged, tops[0]), at(merged, tops[1])) << "the two tops are not merged";
+  ASSERT_EQ(pieces.patches.size(), 2u);
+  EXPECT_NE(at(pieces, tops[0]), at(pieces, tops[1]));
+  EXPECT_GE(at(pieces, tops[0]), 0);
+  EXPECT_GE(at(pieces, tops[1]), 0);
+  // A proposal on a top: its centre within 1 cm of the carton's, its l axis
+  // within 3 degrees of the top's.
+  auto proposes = [&](const FaceProposals& p, const Top& t) {
+    const Eigen::Vector2d axis(std::cos(t.yaw_deg * M_PI / 180), std::sin(t.yaw_deg * M_PI / 180));
+    return std::any_of(p.poses.begin(), p.poses.end(), [&](const Eigen::Isometry3d& pose) {
+      const Eigen::Vector3d c = pose.translation();
+      const Eigen::Vector3d l = pose.linear().col(0);
+      return (c.head<2>() - t.centre).norm() < 0.01 && std::abs(c.z() - (kTop + 0.075)) < 0.01 &&
+             std::abs(l.head<2>().dot(axis)) > std::cos(3.0 * M_PI / 180);
+    });
+  };
+  const FaceProposals with = ProposeFromFaces(image, kCarton, o);
+  EXPECT_TRUE(proposes(with, tops[0]));
+  EXPECT_TRUE(proposes(with, tops[1]));
+  o.propose_merged_pieces = false;
+  const FaceProposals without = ProposeFromFaces(image, kCarton, o);
+  EXPECT_FALSE(proposes(without, tops[1]));
+  EXPECT_LT(without.poses.size(), with.poses.size());
 }
 
 // A carton top whose rim the segmentation took in (here the outline is
