@@ -77,6 +77,8 @@ constexpr char kHelp[] =
     "                       out (0.05; 0: off)\n"
     "  --turned_check BOOL  a box with a side not measured is taken out when its face\n"
     "                       turned a quarter at a measured corner is a box too (true)\n"
+    "  --retake_outranked BOOL a box a check took out no longer blocks the readings\n"
+    "                       it outranked: they are judged again (true)\n"
     "  --turned_proposals BOOL  a hypothesis declined for a side on flat proposes its\n"
     "                       face turned a quarter at its measured corners (true)\n"
     "  --unseen_sides BOOL  a side with nothing seen near it (a shadow) may hide a\n"
@@ -182,6 +184,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("floor_check", &options.floor_check),
         args.SetDouble("level_check", &options.max_below_neighbours_m),
         args.SetBool("turned_check", &options.turned_check),
+        args.SetBool("retake_outranked", &options.retake_outranked),
         args.SetBool("unseen_sides", &options.acceptance.check_unseen_sides),
         args.SetBool("turned_proposals", &options.turned_proposals),
         args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
@@ -304,6 +307,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "floor_check",
                                                        "level_check",
                                                        "turned_check",
+                                                       "retake_outranked",
                                                        "unseen_sides",
                                                        "turned_proposals",
                                                        "layer_plane",

@@ -720,7 +720,11 @@ class BoxAcceptance {
                          return a.box.score > b.box.score;
                        });
       for (internal::Candidate& c : pending) {
-        if (!OverlapsKept(c.box.camera_T_box)) Keep(c);
+        if (!OverlapsKept(c.box.camera_T_box)) {
+          Keep(c);
+        } else {
+          outranked_.push_back(c.box.camera_T_box);
+        }
       }
       // A declined neighbour's neighbours (DetectorOptions::
       // neighbour_steps_past_declined): the chain goes on past a seam missed.
@@ -744,6 +748,30 @@ class BoxAcceptance {
 
   // The readings of each det->boxes entry, for the plausibility checks.
   std::vector<KeptReading>* readings() { return &readings_; }
+
+  // Hypotheses accepted but not kept, a box kept before them in the way,
+  // which no box kept now overlaps (a plausibility check took it out):
+  // each judged again from where it was refined, with the boxes kept now,
+  // and kept when it passes, in the order they were outranked. True when
+  // one was kept.
+  bool KeepOutrankedNowFree() {
+    bool any = false;
+    std::vector<Eigen::Isometry3d> still;
+    for (const Eigen::Isometry3d& pose : std::exchange(outranked_, {})) {
+      if (cancel_.Stopped()) break;
+      if (OverlapsKept(pose)) {
+        still.push_back(pose);
+        continue;
+      }
+      const std::optional<internal::Candidate> c = judge_->JudgeAlone(pose, det_->boxes);
+      if (c && !OverlapsKept(c->box.camera_T_box)) {
+        Keep(*c);
+        any = true;
+      }
+    }
+    outranked_.insert(outranked_.end(), still.begin(), still.end());
+    return any;
+  }
 
  private:
   // Keeps an accepted candidate; it proposes its neighbours.
@@ -851,6 +879,9 @@ class BoxAcceptance {
   internal::HypothesisJudge* const judge_;
   Detection* const det_;
   std::vector<KeptReading> readings_;
+  // Accepted but not kept: a box kept before each overlapped it
+  // (KeepOutrankedNowFree).
+  std::vector<Eigen::Isometry3d> outranked_;
 };
 
 // Phase 5: the face tiles (after the corner hypotheses: a tile on a box
@@ -859,6 +890,7 @@ class BoxAcceptance {
 // accepts is checked again (a few rounds, then a last check with nothing
 // proposed).
 void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
+                             const std::optional<FloorPlane>& floor,
                              internal::HypothesisJudge* judge, BoxAcceptance* acceptance,
                              Detection* det, std::vector<DeclinedCandidate>* declined) {
   const DetectorOptions& options = f.options;
@@ -872,8 +904,6 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
   }
   acceptance->AcceptAll();
   acceptance->AcceptPairsAndTheirs();
-  const std::optional<FloorPlane> floor =
-      options.floor_check ? FindFloor(f.depth, options, faces) : std::nullopt;
   std::vector<Eigen::Isometry3d> cleared;  // CheckTurnedReadings
   auto check = [&] {
     const bool floor_removed =
@@ -898,6 +928,8 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
       }
     }
     acceptance->AcceptAll();
+    // What a box taken out had outranked may be kept now.
+    if (options.retake_outranked && acceptance->KeepOutrankedNowFree()) acceptance->AcceptAll();
   }
   check();
 }
@@ -914,12 +946,19 @@ absl::Status JudgeAndKeep(const PreparedFrame& frame, const SegmentGroups& group
   const DetectorOptions& options = frame.options;
   const Clock::time_point t0 = Clock::now();
   internal::HypothesisJudge judge(frame.depth, options, &cancel);
+  // The floor (DetectorOptions::floor_check) is known before any box is
+  // judged: a reading through it is declined when judged, so it cannot
+  // outrank (and block) another reading of the same face.
+  const std::optional<FloorPlane> floor = options.face_proposals && options.floor_check
+                                              ? FindFloor(frame.depth, options, faces)
+                                              : std::nullopt;
+  if (floor) judge.SetFloor(floor->normal, floor->centroid, options.floor_tolerance_m);
   BoxAcceptance acceptance(options, cancel, &judge, det);
   ProposeFromCorners(*det, groups, options, &judge);
   acceptance.AcceptAll();
   std::vector<DeclinedCandidate> declined;
   if (options.face_proposals) {
-    AcceptFaceTilesAndCheck(frame, faces, &judge, &acceptance, det, &declined);
+    AcceptFaceTilesAndCheck(frame, faces, floor, &judge, &acceptance, det, &declined);
   }
   AlignToLayerPlanes(frame.depth, options.box, options.layer_plane, &det->boxes);
   if (absl::Status s = cancel.Check("the judging of hypotheses"); !s.ok()) return s;

@@ -149,7 +149,9 @@ struct DetectorOptions {
   // With face proposals: no box reaches more than floor_tolerance_m through
   // the floor, the farthest plane the camera sees with planar patches of at
   // least floor_min_area_m2 (and three of the box's largest faces) on it
-  // (detector.cc, CheckFloor). Metres, square metres.
+  // (detector.cc, CheckFloor). The floor is found before the hypotheses
+  // are judged, and one through it is declined then, so that it cannot
+  // outrank another reading of the same face. Metres, square metres.
   bool floor_check = true;
   // Returned boxes side by side on one plane (a pallet layer) take the
   // plane fitted through all their faces (layer_plane.h; max_angle_deg 0
@@ -173,6 +175,12 @@ struct DetectorOptions {
   // cannot separate (a tape edge taken for a seam makes a carton turned
   // across two). Faces whose sides differ by less than 2 cm are skipped.
   bool turned_check = true;
+  // A hypothesis the judge accepted that a box kept before it overlapped
+  // (it ranked below it) is judged again, and kept when it passes, once a
+  // plausibility check (floor, layer, level, gaps, turned readings) has
+  // taken that box out: the reading that won is gone, the one it outranked
+  // may be the box. False: it stays lost.
+  bool retake_outranked = true;
   // A hypothesis refined and declined for a side that runs on flat proposes
   // its face turned a quarter about its normal at each of its corners
   // between two measured sides (free or a seam): a corner proposes both

@@ -130,6 +130,33 @@ TEST(HypothesisJudgeTest, AnAcceptedPoseIsNotJudgedAgain) {
   EXPECT_EQ(judge.stats().refined, 1);
 }
 
+// A plane no box may reach through (HypothesisJudge::SetFloor, the floor
+// DetectorOptions::floor_check finds): a box lying on it is accepted; with
+// the plane raised 5 cm toward the camera, the same box reaches 5 cm
+// through it and is declined when judged.
+TEST(HypothesisJudgeTest, AHypothesisThroughTheFloorIsDeclinedWhenJudged) {
+  const RenderedDepth b = RenderOneBox();
+  const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;
+  DetectorOptions o;
+  o.box = kCartonS;
+  const Eigen::Vector3d n = b.out.floor_plane_camera.head<3>();  // towards the camera
+  const Eigen::Vector3d on_floor = -b.out.floor_plane_camera.w() * n;
+  for (const double raised : {0.0, 0.05}) {
+    internal::HypothesisJudge judge(b.depth, o);
+    judge.SetFloor(n, on_floor + raised * n, 0.03);
+    judge.Propose(gt, 0, {});
+    const std::vector<internal::Candidate> accepted = judge.Evaluate(1);
+    if (raised == 0.0) {
+      EXPECT_EQ(accepted.size(), 1u);
+      continue;
+    }
+    EXPECT_TRUE(accepted.empty());
+    ASSERT_EQ(judge.declined().size(), 1u);
+    EXPECT_NE(judge.declined()[0].reason.find("into the floor"), std::string::npos)
+        << judge.declined()[0].reason;
+  }
+}
+
 // A hypothesis that overlaps a kept box by more than refinement can move it
 // (AcceptanceOptions::settled_overlap_margin_m, 5 cm on every side) is not
 // judged while the box is kept, and is judged when proposed again once the

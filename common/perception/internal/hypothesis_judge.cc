@@ -448,6 +448,24 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, const std::vector<DetectedB
   const double score = JudgeRefined(cand.evidence, cand.refinement, options_.box, grasp, acceptance,
                                     reason, out_of_view);
   if (score < 0.0) return false;
+  if (floor_) {
+    const BoxDims& d = options_.box;
+    double deepest = -std::numeric_limits<double>::max();
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner =
+          cand.box.camera_T_box * Eigen::Vector3d((c & 1 ? 0.5 : -0.5) * d.l,
+                                                  (c & 2 ? 0.5 : -0.5) * d.b,
+                                                  (c & 4 ? 0.5 : -0.5) * d.h);
+      deepest = std::max(deepest, -floor_->normal.dot(corner - floor_->centroid));
+    }
+    if (deepest > floor_->tolerance_m) {
+      *reason = absl::StrFormat(
+          "the box would reach %.0f mm into the floor (a flat piece of something else of a "
+          "face's size)",
+          1000.0 * deepest);
+      return false;
+    }
+  }
   if (!in_view && out_of_view < 0 &&
       !(acceptance.measured_face_may_leave_view &&
         PinnedOnEverySide(cand.refinement.sides, acceptance.leaving_view_free_axes))) {

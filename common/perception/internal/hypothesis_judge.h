@@ -113,6 +113,14 @@ class HypothesisJudge {
   // (DetectorOptions::neighbour_steps_past_declined).
   std::vector<SteppingStone> TakeSteppingStones() { return std::exchange(stepping_stones_, {}); }
 
+  // A plane no box reaches through by more than tolerance_m (the floor,
+  // DetectorOptions::floor_check): a hypothesis that does is declined when
+  // judged, before it can outrank a reading of the same face that does not.
+  void SetFloor(const Eigen::Vector3d& normal, const Eigen::Vector3d& centroid,
+                double tolerance_m) {
+    floor_ = Floor{normal, centroid, tolerance_m};
+  }
+
   // Proposals queued and not yet evaluated (the turned readings of the last
   // round's declined hypotheses: DetectorOptions::turned_proposals).
   bool Queued() const { return !queue_.empty(); }
@@ -167,6 +175,11 @@ class HypothesisJudge {
   // ~2.5 degrees up to the box's symmetries), or -1.
   int FindLike(const std::vector<Eigen::Isometry3d>& poses, const Eigen::Isometry3d& pose) const;
 
+  struct Floor {
+    Eigen::Vector3d normal, centroid;  // the normal points at the camera
+    double tolerance_m;
+  };
+  std::optional<Floor> floor_;
   const DepthImage& depth_;
   const DetectorOptions& options_;
   // options_.refinement for the neighbours of boxes found: every iteration.
