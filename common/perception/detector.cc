@@ -179,22 +179,9 @@ std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptio
 bool CheckFloor(const FloorPlane& floor, const DetectorOptions& options,
                 std::vector<DetectedBox>* boxes, std::vector<KeptReading>* readings,
                 std::vector<DeclinedCandidate>* declined) {
-  const BoxDims& d = options.box;
-  return TakeOut(boxes, readings, declined, [&](size_t i) -> std::string {
-    const Eigen::Isometry3d& pose = (*boxes)[i].camera_T_box;
-    double deepest = -std::numeric_limits<double>::max();
-    for (int c = 0; c < 8; ++c) {
-      const Eigen::Vector3d corner =
-          pose * Eigen::Vector3d((c & 1 ? 0.5 : -0.5) * d.l, (c & 2 ? 0.5 : -0.5) * d.b,
-                                 (c & 4 ? 0.5 : -0.5) * d.h);
-      // How far beyond the floor, away from the camera.
-      deepest = std::max(deepest, -floor.normal.dot(corner - floor.centroid));
-    }
-    if (deepest <= options.floor_tolerance_m) return "";
-    return absl::StrFormat(
-        "the box would reach %.0f mm into the floor (a flat piece of "
-        "something else of a face's size)",
-        1000.0 * deepest);
+  return TakeOut(boxes, readings, declined, [&](size_t i) {
+    return internal::ThroughFloor((*boxes)[i].camera_T_box, options.box, floor.normal,
+                                  floor.centroid, options.floor_tolerance_m);
   });
 }
 

@@ -126,6 +126,23 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
                     0.0, 1.0);
 }
 
+std::string ThroughFloor(const Eigen::Isometry3d& camera_T_box, const BoxDims& dims,
+                         const Eigen::Vector3d& normal, const Eigen::Vector3d& on_plane,
+                         double tolerance_m) {
+  double deepest = -std::numeric_limits<double>::max();
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d corner =
+        camera_T_box * Eigen::Vector3d((c & 1 ? 0.5 : -0.5) * dims.l, (c & 2 ? 0.5 : -0.5) * dims.b,
+                                       (c & 4 ? 0.5 : -0.5) * dims.h);
+    deepest = std::max(deepest, -normal.dot(corner - on_plane));
+  }
+  if (deepest <= tolerance_m) return "";
+  return absl::StrFormat(
+      "the box would reach %.0f mm into the floor (a flat piece of something else of a face's "
+      "size)",
+      1000.0 * deepest);
+}
+
 bool OneSideOnFlat(const RefinementResult& ref) {
   int on_flat = 0;
   for (SideKind k : ref.sides) {
@@ -449,20 +466,10 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, const std::vector<DetectedB
                                     reason, out_of_view);
   if (score < 0.0) return false;
   if (floor_) {
-    const BoxDims& d = options_.box;
-    double deepest = -std::numeric_limits<double>::max();
-    for (int c = 0; c < 8; ++c) {
-      const Eigen::Vector3d corner =
-          cand.box.camera_T_box * Eigen::Vector3d((c & 1 ? 0.5 : -0.5) * d.l,
-                                                  (c & 2 ? 0.5 : -0.5) * d.b,
-                                                  (c & 4 ? 0.5 : -0.5) * d.h);
-      deepest = std::max(deepest, -floor_->normal.dot(corner - floor_->centroid));
-    }
-    if (deepest > floor_->tolerance_m) {
-      *reason = absl::StrFormat(
-          "the box would reach %.0f mm into the floor (a flat piece of something else of a "
-          "face's size)",
-          1000.0 * deepest);
+    if (std::string why = ThroughFloor(cand.box.camera_T_box, options_.box, floor_->normal,
+                                       floor_->centroid, floor_->tolerance_m);
+        !why.empty()) {
+      *reason = std::move(why);
       return false;
     }
   }

@@ -60,6 +60,14 @@ std::vector<Eigen::Isometry3d> TurnedAtMeasuredCorners(const Eigen::Isometry3d& 
                                                        const std::array<SideKind, 4>& sides,
                                                        const BoxDims& dims);
 
+// Why a box cannot be there when it reaches more than tolerance_m through
+// a plane (the floor: `normal` towards the camera, `on_plane` a point of
+// it), its deepest corner measured away from the camera; "" when it does
+// not.
+std::string ThroughFloor(const Eigen::Isometry3d& camera_T_box, const BoxDims& dims,
+                         const Eigen::Vector3d& normal, const Eigen::Vector3d& on_plane,
+                         double tolerance_m);
+
 class HypothesisJudge {
  public:
   // A stopped `cancel` (may be null) leaves the rest of a queue unjudged.
