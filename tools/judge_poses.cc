@@ -54,10 +54,14 @@ const char* SideName(SideKind k) {
   return "?";
 }
 
-// Judges one pose as the detector does (first look, refinement, the
-// acceptance test) and prints each step; returns the grasp face.
+// Judges one pose step by step (first look, refinement, the acceptance
+// test) and prints each step, then the verdict of the detector's own judge
+// (internal::HypothesisJudge::JudgeAlone: also the view, floor and
+// orientation tests that come after the acceptance test; the floor only
+// when `judge` was given one); returns the grasp face.
 BoxFace JudgeOne(const DepthImage& depth, const DetectorOptions& options,
-                 const Eigen::Isometry3d& pose, bool per_face) {
+                 const internal::HypothesisJudge& judge, const Eigen::Isometry3d& pose,
+                 bool per_face) {
   const BoxEvidence first = MeasureBox(depth, pose, options.box, options.evidence);
   const FaceEvidence& g = first.faces[static_cast<int>(first.grasp_face)];
   std::printf(" first look support %.2f, grasp agree %.2f, see-through %.3f", first.support(),
@@ -103,6 +107,14 @@ BoxFace JudgeOne(const DepthImage& depth, const DetectorOptions& options,
   } else {
     std::printf("; declined: %s", reason.c_str());
   }
+  std::string why;
+  if (judge.JudgeAlone(pose, {}, &why)) {
+    std::printf("; the detector's judge: ACCEPTED");
+  } else {
+    std::printf(
+        "; the detector's judge: declined: %s",
+        why.empty() ? "not refined (the first look, or the face not in view)" : why.c_str());
+  }
   return first.grasp_face;
 }
 
@@ -140,6 +152,7 @@ int Run(const CommandArgs& args) {
   }
   // The face-first proposals, to tell which boxes they reach.
   const FaceProposals faces = ProposeFromFaces(depth, options.box, options.faces);
+  const internal::HypothesisJudge judge(depth, options);
   for (const nlohmann::json& b : doc["boxes"]) {
     const bool gt = b.contains("T_cam_box");
     if (gt && !args.Has("all") && !(b.value("target", false) && b.value("pickable", false))) {
@@ -151,7 +164,7 @@ int Run(const CommandArgs& args) {
       for (int c = 0; c < 4; ++c) pose.matrix()(r, c) = m[r][c].get<double>();
     }
     std::printf("box %s:", gt ? std::to_string(b.value("id", 0)).c_str() : "?");
-    const BoxFace grasp_face = JudgeOne(depth, options, pose, args.Has("per_face"));
+    const BoxFace grasp_face = JudgeOne(depth, options, judge, pose, args.Has("per_face"));
     // The nearest face proposal, and the planar patch under the face's centre.
     double nearest = 1e9;
     const Eigen::Isometry3d* nearest_pose = nullptr;
@@ -183,7 +196,7 @@ int Run(const CommandArgs& args) {
           Eigen::AngleAxisd(nearest_pose->linear() * pose.linear().transpose()).angle() * 180.0 /
           M_PI;
       std::printf("  face proposal %.0f mm, %.0f deg off:", 1000.0 * nearest, turn);
-      JudgeOne(depth, options, *nearest_pose, args.Has("per_face"));
+      JudgeOne(depth, options, judge, *nearest_pose, args.Has("per_face"));
       std::printf("\n");
     }
   }

@@ -154,6 +154,10 @@ TEST(HypothesisJudgeTest, AHypothesisThroughTheFloorIsDeclinedWhenJudged) {
     ASSERT_EQ(judge.declined().size(), 1u);
     EXPECT_NE(judge.declined()[0].reason.find("into the floor"), std::string::npos)
         << judge.declined()[0].reason;
+    // Judged alone (as tools/judge_poses does), with the reason.
+    std::string why;
+    EXPECT_FALSE(judge.JudgeAlone(gt, {}, &why).has_value());
+    EXPECT_NE(why.find("into the floor"), std::string::npos) << why;
   }
 }
 

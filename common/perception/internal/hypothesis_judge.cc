@@ -391,13 +391,14 @@ std::vector<Eigen::Isometry3d> TurnedAtMeasuredCorners(const Eigen::Isometry3d& 
 }
 
 std::optional<Candidate> HypothesisJudge::JudgeAlone(const Eigen::Isometry3d& camera_T_box,
-                                                     const std::vector<DetectedBox>& kept) const {
+                                                     const std::vector<DetectedBox>& kept,
+                                                     std::string* reason) const {
   Candidate c;
   bool refined = false;
-  std::string reason;
-  if (!EvaluateOne(Proposal{camera_T_box, 0, {}, false}, kept, &c, &refined, &reason)) {
-    return std::nullopt;
-  }
+  std::string why;
+  const bool ok = EvaluateOne(Proposal{camera_T_box, 0, {}, false}, kept, &c, &refined, &why);
+  if (reason != nullptr) *reason = ok ? "" : std::move(why);
+  if (!ok) return std::nullopt;
   return c;
 }
 

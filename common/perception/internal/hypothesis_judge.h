@@ -100,10 +100,12 @@ class HypothesisJudge {
   // settled_overlap_margin_m) are not judged, and may be proposed again.
   std::vector<Candidate> Evaluate(int threads, const std::vector<DetectedBox>& kept = {});
   // Judges one pose now, outside the queue: no duplicate is dropped and
-  // nothing is recorded. The accepted candidate, or nothing. `kept`: boxes
-  // taken as kept (a side against one is a seam: SeamsAgainstKept).
+  // nothing is recorded. The accepted candidate, or nothing (then, with
+  // `reason`, why; "" when it did not get as far as refinement). `kept`:
+  // boxes taken as kept (a side against one is a seam: SeamsAgainstKept).
   std::optional<Candidate> JudgeAlone(const Eigen::Isometry3d& camera_T_box,
-                                      const std::vector<DetectedBox>& kept = {}) const;
+                                      const std::vector<DetectedBox>& kept = {},
+                                      std::string* reason = nullptr) const;
   // The hypotheses refined and declined since the last call only for one
   // side that runs on flat, every other side ended (OneSideOnFlat;
   // AcceptanceOptions::pairs_end_each_other): two of them that run on flat
