@@ -97,7 +97,7 @@ bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<KeptReading>* readings
 // normal: the floor or table under a pallet, a heap or a bin), with no more
 // than 1 % of the frame beyond it (past floor_tolerance_m, or three times
 // the floor's own scatter scaled by z^2 to the point's depth). Found once a
-// frame: the patches do not change between the checks' rounds.
+// frame, before any hypothesis is judged (HypothesisJudge::SetFloor).
 struct FloorPlane {
   Eigen::Vector3d normal, centroid;  // the normal points at the camera
   double rms = 0.0;                  // its points' scatter about it, metres
@@ -169,20 +169,6 @@ std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptio
   }
   if (seen == 0 || beyond > 0.01 * seen) return std::nullopt;
   return floor;
-}
-
-// A box cannot reach through the floor: one with a corner more than
-// floor_tolerance_m beyond it is taken out (a "box" whose face is a
-// pallet's deck board reaches its own height into the floor, and so does a
-// box of another size read as this one on end). True when a box was taken
-// out.
-bool CheckFloor(const FloorPlane& floor, const DetectorOptions& options,
-                std::vector<DetectedBox>* boxes, std::vector<KeptReading>* readings,
-                std::vector<DeclinedCandidate>* declined) {
-  return TakeOut(boxes, readings, declined, [&](size_t i) {
-    return internal::ThroughFloor((*boxes)[i].camera_T_box, options.box, floor.normal,
-                                  floor.centroid, options.floor_tolerance_m);
-  });
 }
 
 // A box stands on something: amid the boxes of a layer found around it,
@@ -877,7 +863,6 @@ class BoxAcceptance {
 // accepts is checked again (a few rounds, then a last check with nothing
 // proposed).
 void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
-                             const std::optional<FloorPlane>& floor,
                              internal::HypothesisJudge* judge, BoxAcceptance* acceptance,
                              Detection* det, std::vector<DeclinedCandidate>* declined) {
   const DetectorOptions& options = f.options;
@@ -893,8 +878,6 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
   acceptance->AcceptPairsAndTheirs();
   std::vector<Eigen::Isometry3d> cleared;  // CheckTurnedReadings
   auto check = [&] {
-    const bool floor_removed =
-        floor && CheckFloor(*floor, options, &det->boxes, acceptance->readings(), declined);
     const bool layer_removed =
         options.faces.check_layer_tiling &&
         CheckLayers(f.depth, options, faces, &det->boxes, acceptance->readings(), declined);
@@ -906,7 +889,7 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
     const bool turned_removed =
         options.turned_check && CheckTurnedReadings(*judge, options, &det->boxes,
                                                     acceptance->readings(), declined, &cleared);
-    return floor_removed || layer_removed || level_removed || gaps_removed || turned_removed;
+    return layer_removed || level_removed || gaps_removed || turned_removed;
   };
   for (int round = 0; round < 3 && check(); ++round) {
     for (const LayerTiles& layer : faces.layers) {
@@ -934,8 +917,11 @@ absl::Status JudgeAndKeep(const PreparedFrame& frame, const SegmentGroups& group
   const Clock::time_point t0 = Clock::now();
   internal::HypothesisJudge judge(frame.depth, options, &cancel);
   // The floor (DetectorOptions::floor_check) is known before any box is
-  // judged: a reading through it is declined when judged, so it cannot
-  // outrank (and block) another reading of the same face.
+  // judged: a reading with a corner more than floor_tolerance_m through it
+  // (a pallet's deck board read as a box reaches its own height into the
+  // floor, and so does a box of another size read as this one on end) is
+  // declined when judged, so it cannot outrank (and block) another reading
+  // of the same face. Every box kept is judged so: no check after.
   const std::optional<FloorPlane> floor = options.face_proposals && options.floor_check
                                               ? FindFloor(frame.depth, options, faces)
                                               : std::nullopt;
@@ -945,7 +931,7 @@ absl::Status JudgeAndKeep(const PreparedFrame& frame, const SegmentGroups& group
   acceptance.AcceptAll();
   std::vector<DeclinedCandidate> declined;
   if (options.face_proposals) {
-    AcceptFaceTilesAndCheck(frame, faces, floor, &judge, &acceptance, det, &declined);
+    AcceptFaceTilesAndCheck(frame, faces, &judge, &acceptance, det, &declined);
   }
   AlignToLayerPlanes(frame.depth, options.box, options.layer_plane, &det->boxes);
   if (absl::Status s = cancel.Check("the judging of hypotheses"); !s.ok()) return s;

@@ -149,9 +149,9 @@ struct DetectorOptions {
   // With face proposals: no box reaches more than floor_tolerance_m through
   // the floor, the farthest plane the camera sees with planar patches of at
   // least floor_min_area_m2 (and three of the box's largest faces) on it
-  // (detector.cc, CheckFloor). The floor is found before the hypotheses
-  // are judged, and one through it is declined then, so that it cannot
-  // outrank another reading of the same face. Metres, square metres.
+  // (detector.cc, FindFloor). The floor is found before the hypotheses are
+  // judged, and one through it is declined then, so that it cannot outrank
+  // another reading of the same face. Metres, square metres.
   bool floor_check = true;
   // Returned boxes side by side on one plane (a pallet layer) take the
   // plane fitted through all their faces (layer_plane.h; max_angle_deg 0

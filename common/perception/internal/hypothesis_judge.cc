@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <numbers>
 #include <optional>
 
 #include "absl/strings/str_format.h"
+#include "common/perception/box_pose.h"
 #include "common/perception/internal/border_faces.h"
 #include "common/perception/internal/box_overlap.h"
 #include "common/perception/internal/kept_neighbours.h"
@@ -130,10 +132,7 @@ std::string ThroughFloor(const Eigen::Isometry3d& camera_T_box, const BoxDims& d
                          const Eigen::Vector3d& normal, const Eigen::Vector3d& on_plane,
                          double tolerance_m) {
   double deepest = -std::numeric_limits<double>::max();
-  for (int c = 0; c < 8; ++c) {
-    const Eigen::Vector3d corner =
-        camera_T_box * Eigen::Vector3d((c & 1 ? 0.5 : -0.5) * dims.l, (c & 2 ? 0.5 : -0.5) * dims.b,
-                                       (c & 4 ? 0.5 : -0.5) * dims.h);
+  for (const Eigen::Vector3d& corner : BoxCorners(camera_T_box, dims)) {
     deepest = std::max(deepest, -normal.dot(corner - on_plane));
   }
   if (deepest <= tolerance_m) return "";

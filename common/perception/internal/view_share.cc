@@ -8,6 +8,7 @@
 #include <boost/geometry/geometries/point_xy.hpp>
 #include <boost/geometry/geometries/polygon.hpp>
 
+#include "common/perception/box_pose.h"
 #include "common/perception/camera_model.h"
 
 namespace cornerpose::internal {
@@ -20,10 +21,7 @@ double BoxViewShare(const CameraIntrinsics& camera, const Eigen::Isometry3d& cam
                     const BoxDims& dims) {
   constexpr double kMinDepthM = 0.05;
   bg::model::multi_point<Point> corners;
-  for (int i = 0; i < 8; ++i) {
-    const Eigen::Vector3d local(((i & 1) ? 0.5 : -0.5) * dims.l, ((i & 2) ? 0.5 : -0.5) * dims.b,
-                                ((i & 4) ? 0.5 : -0.5) * dims.h);
-    const Eigen::Vector3d p = camera_T_box * local;
+  for (const Eigen::Vector3d& p : BoxCorners(camera_T_box, dims)) {
     if (!(p.z() > kMinDepthM)) return 0.0;
     const Eigen::Vector2d px = Project(camera, p);
     corners.emplace_back(px.x(), px.y());
