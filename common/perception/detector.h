@@ -177,7 +177,7 @@ struct DetectorOptions {
   bool turned_check = true;
   // A hypothesis the judge accepted that a box kept before it overlapped
   // (it ranked below it) is judged again, and kept when it passes, once a
-  // plausibility check (floor, layer, level, gaps, turned readings) has
+  // plausibility check (layer, level, gaps, turned readings) has
   // taken that box out: the reading that won is gone, the one it outranked
   // may be the box. False: it stays lost.
   bool retake_outranked = true;
