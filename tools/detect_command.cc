@@ -126,6 +126,8 @@ constexpr char kHelp[] =
     "                       face's corners by more than M (0.003; 0: never)\n"
     "  --rim_sides BOOL     a side where the face runs on but ends within 2 cm is free\n"
     "                       there, when it is the face's only side in doubt (true)\n"
+    "  --side_ends SHARE    a side where the face ends within 5 mm along SHARE of it\n"
+    "                       is free, whatever lies flat past the rest (0.67; 0: off)\n"
     "  --anchored_faces BOOL a planar patch that does not tile (an L of box tops, a\n"
     "                       layer cut by the border) proposes a face in each of its\n"
     "                       corners (false)\n"
@@ -207,6 +209,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("seam_split", &options.faces.seam_split.enabled),
         args.SetBool("merged_pieces", &options.faces.propose_merged_pieces),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
+        args.SetDouble("side_ends", &options.refinement.side_ends_share),
         args.SetDouble("end_on_flat", &options.refinement.end_on_flat_shift_m),
         args.SetDouble("slat_gap", &options.refinement.slat_gap_max_m),
         args.SetDouble("extra_step", &options.refinement.extra_step_corner_move_m),
@@ -332,6 +335,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "seam_split",
                                                        "merged_pieces",
                                                        "rim_sides",
+                                                       "side_ends",
                                                        "end_on_flat",
                                                        "slat_gap",
                                                        "extra_step",

@@ -639,11 +639,14 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
     return m;
   }
   // Outermost point per bin, then a robust line through them: where the
-  // face ends (false when too few bins have a point).
-  auto measure_end = [&](SideMeasure* out) {
+  // face ends (false when too few bins have a point), from the bins whose
+  // outermost point lies no further out than `up_to`.
+  auto measure_end = [&](SideMeasure* out, double up_to = 1.0) {
     std::vector<std::pair<double, double>> ends;  // (along, across)
     for (int k = 0; k < nbins; ++k) {
-      if (best[k] > -1.0) ends.emplace_back(-half_other + band + (k + 0.5) * bin, best[k]);
+      if (best[k] > -1.0 && best[k] <= up_to) {
+        ends.emplace_back(-half_other + band + (k + 0.5) * bin, best[k]);
+      }
     }
     if (static_cast<int>(ends.size()) < std::max(3, nbins / 3)) return false;
     std::vector<double> across;
@@ -661,6 +664,17 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
     out->slope = slopes.empty() ? 0.0 : Median(slopes);
     return true;
   };
+  // Something flat past only part of the side, the face ending at the side
+  // along the rest (RefinementOptions::side_ends_share): the side is free
+  // where the face ends, measured along that rest.
+  if (outer > o.free_side_ratio * inner && o.side_ends_share > 0.0) {
+    const int ends = static_cast<int>(std::count_if(
+        best.begin(), best.end(), [&](double b) { return b > -1.0 && b <= half + 0.005; }));
+    if (ends >= o.side_ends_share * nbins && measure_end(&m, half + 0.005)) {
+      m.kind = SideKind::kFree;
+      return m;
+    }
+  }
   if (outer > o.free_side_ratio * inner) {
     // The face continues past the side: a seam to a touching box, or the
     // hypothesis is too small for this face.
@@ -1020,6 +1034,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.tile_tolerance_m", tile_tolerance_m, 0.0, 0.2),
            CheckRange("refinement.max_tile_march_m", max_tile_march_m, 0.0, 100.0),
            CheckRange("refinement.rim_extent_tolerance_m", rim_extent_tolerance_m, 0.0, 0.1),
+           CheckRange("refinement.side_ends_share", side_ends_share, 0.0, 1.0),
            CheckRange("refinement.iterations", iterations, 0, 20),
            CheckRange("refinement.end_on_flat_shift_m", end_on_flat_shift_m, 0.0, 0.05),
            CheckRange("refinement.extra_step_corner_move_m", extra_step_corner_move_m, 0.0, 0.05),

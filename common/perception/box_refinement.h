@@ -90,6 +90,15 @@ struct RefinementOptions {
   // from this short to twice this long, along it within this (where both
   // its sides are free). Metres.
   double rim_extent_tolerance_m = 0.015;
+  // A side past which the face's plane goes on along only part of it is
+  // free when, read in 1 cm stretches, the face ends within 5 mm past the
+  // side along at least this share of it: what lies flat past the rest is
+  // something else touching the box there (in a heap, a neighbour's face
+  // crossing the plane at one corner; a box beside it set off by most of a
+  // side). The side is then where the face ends along those stretches.
+  // A face that runs on (a bigger face, a layer) does so along all of the
+  // side. 0: off (the side runs on, or is a seam). Unitless.
+  double side_ends_share = 0.67;
   // A seam found along a side whose stretch (its length less a band at
   // each end) is at least this long turns the face as a free side does:
   // by where each half of the side has the seam. Seams along shorter

@@ -367,6 +367,9 @@ TEST(RefinementOptionsTest, ValidateNamesTheNewFields) {
   o.seam_turn_max_deg = 10.0;
   o.seen_through_share = 1.5;
   EXPECT_NE(o.Validate().message().find("seen_through_share"), std::string::npos);
+  o.seen_through_share = 0.4;
+  o.side_ends_share = -0.1;
+  EXPECT_NE(o.Validate().message().find("side_ends_share"), std::string::npos);
 }
 
 // A carton of the layer under another that stands on it right at the
@@ -466,6 +469,40 @@ TEST(RefineOnGraspFaceTest, ASeamPastAFaceThatReadsLongIsFoundOutward) {
   pose = from_free_end;
   EXPECT_EQ(RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), symmetric, &pose).sides[0],
             SideKind::kContinues);
+}
+
+// A carton with another one beside its +x end, set off across it so that
+// the two meet along only 6 cm of the carton's 20 cm end (their tops
+// level, no gap): the face ends at that side along most of it, and the side
+// is free there (RefinementOptions::side_ends_share); with the rule off it
+// is not. A carton the other one meets along all of its end (3 mm apart)
+// still has a seam there, not a free side.
+TEST(RefineOnGraspFaceTest, ASideANeighbourMeetsAtOneCornerIsFree) {
+  const FlatScene s =
+      RenderFlat({Flat(kCartonS, 0.0, 0.0), Flat(kCartonS, kCartonS.l, kCartonS.b - 0.06)});
+  const GroundTruthBox& gt = s.rendered.boxes[0];
+  const Eigen::Isometry3d start = Moved(gt.camera_T_box, 0.004, -0.003, 1.0);
+  Eigen::Isometry3d pose = start;
+  const RefinementResult r =
+      RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), RefinementOptions{}, &pose);
+  ASSERT_TRUE(r.ok);
+  for (SideKind k : r.sides) EXPECT_EQ(k, SideKind::kFree);
+  const PoseError e = ComparePoses(pose, gt.camera_T_box, kCartonS);
+  EXPECT_LT(e.translation_m, 0.003);
+  EXPECT_LT(e.rotation_deg, 1.0);
+  RefinementOptions off;
+  off.side_ends_share = 0.0;
+  pose = start;
+  EXPECT_NE(RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), off, &pose).sides[0],
+            SideKind::kFree);
+
+  const FlatScene whole =
+      RenderFlat({Flat(kCartonS, 0.0, 0.0), Flat(kCartonS, kCartonS.l + 0.003, 0.0)});
+  pose = Moved(whole.rendered.boxes[0].camera_T_box, 0.004, -0.003, 1.0);
+  EXPECT_EQ(RefineOnGraspFace(whole.depth, kCartonS, TopFace(whole.rendered.boxes[0]),
+                              RefinementOptions{}, &pose)
+                .sides[0],
+            SideKind::kSeam);
 }
 
 }  // namespace
