@@ -83,6 +83,8 @@ constexpr char kHelp[] =
     "                       face turned a quarter at its measured corners (true)\n"
     "  --unseen_sides BOOL  a side with nothing seen near it (a shadow) may hide a\n"
     "                       longer side of the box, as an occluded one does (true)\n"
+    "  --unseen_longer S    ... unless S of the box so read longer is seen through\n"
+    "                       (0.2; 0: never)\n"
     "  --layer_plane DEG    boxes side by side on one plane (a layer) take the plane\n"
     "                       fitted through all their faces when within DEG of it (12;\n"
     "                       0: every box keeps its own face's plane)\n"
@@ -188,6 +190,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("turned_check", &options.turned_check),
         args.SetBool("retake_outranked", &options.retake_outranked),
         args.SetBool("unseen_sides", &options.acceptance.check_unseen_sides),
+        args.SetDouble("unseen_longer", &options.acceptance.unseen_longer_see_through),
         args.SetBool("turned_proposals", &options.turned_proposals),
         args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
         args.SetDouble("layer_adopt", &options.layer_plane.adopt_angle_deg),
@@ -312,6 +315,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "turned_check",
                                                        "retake_outranked",
                                                        "unseen_sides",
+                                                       "unseen_longer",
                                                        "turned_proposals",
                                                        "layer_plane",
                                                        "layer_adopt",

@@ -89,8 +89,9 @@ BoxFace JudgeOne(const DepthImage& depth, const DetectorOptions& options,
   if (out_of_view >= 0) std::printf(", side %d out of view pinned", out_of_view);
   const BoxEvidence ev = MeasureBox(depth, refined, options.box, options.evidence);
   std::string reason;
-  const double score = internal::JudgeRefined(ev, ref, options.box, first.grasp_face,
-                                              options.acceptance, &reason, out_of_view);
+  const double score = internal::JudgeRefined(
+      ev, ref, options.box, first.grasp_face, options.acceptance, &reason, out_of_view,
+      internal::LongerReadingsRuledOut(depth, refined, first.grasp_face, ref, options));
   if (per_face) {
     for (int fi = 0; fi < 6; ++fi) {
       const FaceEvidence& e = ev.faces[fi];

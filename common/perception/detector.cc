@@ -393,6 +393,7 @@ absl::Status AcceptanceOptions::Validate() const {
            CheckRange("acceptance.max_grasp_occluded", max_grasp_occluded, 0.0, 1.0),
            CheckRange("acceptance.max_occluded", max_occluded, 0.0, 1.0),
            CheckRange("acceptance.max_see_through", max_see_through, 0.0, 1.0),
+           CheckRange("acceptance.unseen_longer_see_through", unseen_longer_see_through, 0.0, 1.0),
            CheckRange("acceptance.min_grasp_pixels", min_grasp_pixels, 1, 1'000'000),
            CheckPositive("acceptance.extent_tolerance_m", extent_tolerance_m, 1.0),
            CheckRange("acceptance.max_grasp_view_angle_deg", max_grasp_view_angle_deg, 0.0, 90.0),

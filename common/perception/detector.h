@@ -55,6 +55,14 @@ struct AcceptanceOptions {
   // over it, read as a carton on its side). False: an unseen side says
   // nothing.
   bool check_unseen_sides = true;
+  // ... unless the depth image rules that longer reading out: at least this
+  // share of the box so read (HypothesisJudge's LongerUnderSide) is seen
+  // through, the camera seeing the floor past the shadow where the box
+  // would be (a brick in a heap, its ends in its own shadows). Four times
+  // what a box kept may show (max_see_through). Occluded sides keep the
+  // rule: what stands over one hides where the face goes on. Unitless,
+  // [0, 1]; 0: an unseen side always leaves the size in doubt.
+  double unseen_longer_see_through = 0.2;
   // Largest angle between the grasp face's normal and the line of sight to
   // its centre. Degrees.
   double max_grasp_view_angle_deg = 60.0;

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/perception/box_pose.h"
 #include "common/perception/internal/box_overlap.h"
 #include "common/perception/pose_error.h"
 #include "tests/support/scene_generator.h"
@@ -454,6 +455,71 @@ TEST(RefinementVerdictTest, AnUnseenSideWhereALongerSideCouldStandIsDeclined) {
   ref.sides = {SideKind::kUnknown, SideKind::kFree, SideKind::kUnknown, SideKind::kFree};
   ref.free_sides = 2;
   EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusZ, o), "");
+}
+
+// The longer reading under side 2 of a carton_s read on its +x end face
+// (0.20 x 0.15; side 2 ends its 0.15 axis): the face runs on from side 3
+// to the box's third side (0.30), the box 0.15 deep behind it.
+TEST(LongerUnderSideTest, TheFaceRunsOnFromTheOppositeSideToTheThirdSide) {
+  const Eigen::Isometry3d pose = Eigen::Translation3d(0.1, -0.2, 1.5) *
+                                 Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized());
+  // +x face: a is the box's y, b its z; side 2 lies at +z.
+  const Eigen::Isometry3d longer = internal::LongerUnderSide(pose, BoxFace::kPlusX, kCartonS, 2);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+  for (const Eigen::Vector3d& c : BoxCorners(longer, kCartonS)) {
+    const Eigen::Vector3d in_box = pose.inverse() * c;
+    lo = lo.cwiseMin(in_box);
+    hi = hi.cwiseMax(in_box);
+  }
+  EXPECT_NEAR(hi.x(), 0.15, 1e-9);   // the face's plane
+  EXPECT_NEAR(lo.x(), 0.0, 1e-9);    // 0.15 deep
+  EXPECT_NEAR(lo.y(), -0.10, 1e-9);  // the other axis as it was
+  EXPECT_NEAR(hi.y(), 0.10, 1e-9);
+  EXPECT_NEAR(lo.z(), -0.075, 1e-9);  // from side 3 ...
+  EXPECT_NEAR(hi.z(), 0.225, 1e-9);   // ... 0.30 on past side 2
+}
+
+// A brick standing on its long edge, its top (0.19 x 0.057) read with one
+// 0.057 side unseen: a brick lying on its side, its 0.19 x 0.09 face running
+// on 3.3 cm there, could stand in, and the reading is declined. Past that
+// side the camera sees the floor 9 cm below where that face would be: the
+// depth rules the longer reading out (AcceptanceOptions::
+// unseen_longer_see_through) and the reading stands. A block as tall as
+// the longer reading standing against that side leaves it possible.
+TEST(RefinementVerdictTest, AnUnseenSideWhoseLongerReadingIsSeenThroughLeavesNoDoubt) {
+  constexpr BoxDims kBrick{0.19, 0.09, 0.057};
+  const BoxDims block{0.19, 0.04, 0.09};
+  Scene scene;
+  scene.world_T_camera = LookAtCamera(Eigen::Vector3d::Zero(), 1.0, 10.0, 20.0, 0.0);
+  Eigen::Isometry3d on_edge(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()));
+  on_edge.translation().z() = kBrick.b / 2.0;  // the box's y up, its z along -y
+  scene.boxes.push_back({kBrick, on_edge, true});
+  const RenderedDepth alone = RenderNoiseFree(scene);
+  Eigen::Isometry3d beside = Eigen::Isometry3d::Identity();
+  beside.translation() =
+      Eigen::Vector3d(0.0, -kBrick.h / 2.0 - 0.001 - block.b / 2.0, block.h / 2.0);
+  scene.boxes.push_back({block, beside, false});
+  const RenderedDepth with_block = RenderNoiseFree(scene);
+
+  const GroundTruthBox& gt = alone.out.boxes.at(0);
+  ASSERT_EQ(static_cast<int>(gt.grasp_face) / 2, 1) << "the box's y face up";
+  // The face's a axis is the box's z: side 0 lies at +z, over the block.
+  const RefinementResult ref = ReadWithOneUnseenSide(0);
+  DetectorOptions o;
+  o.box = kBrick;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kBrick, gt.grasp_face, o.acceptance),
+            "a hidden side could be a longer side of the box");
+  const unsigned ruled_out =
+      internal::LongerReadingsRuledOut(alone.depth, gt.camera_T_box, gt.grasp_face, ref, o);
+  EXPECT_EQ(ruled_out, 1u);
+  EXPECT_EQ(internal::RefinementVerdict(ref, kBrick, gt.grasp_face, o.acceptance, -1, ruled_out),
+            "");
+  EXPECT_EQ(internal::LongerReadingsRuledOut(
+                with_block.depth, with_block.out.boxes.at(0).camera_T_box, gt.grasp_face, ref, o),
+            0u);
+  o.acceptance.unseen_longer_see_through = 0.0;
+  EXPECT_EQ(internal::LongerReadingsRuledOut(alone.depth, gt.camera_T_box, gt.grasp_face, ref, o),
+            0u);
 }
 
 // A pair may end each other (AcceptanceOptions::pairs_end_each_other) only

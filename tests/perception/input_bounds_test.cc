@@ -80,7 +80,7 @@ TEST(InputBoundsTest, IntrinsicsOutsidePlausibleRangesNameFieldValueAndRange) {
   EXPECT_TRUE(k.Validate().ok()) << k.Validate();
 }
 
-TEST(InputBoundsTest, DetectorOptionsNameTheLevelCheckOutOfRange) {
+TEST(InputBoundsTest, DetectorOptionsNameTheFieldOutOfRange) {
   DetectorOptions options;
   options.box = BoxDims{0.30, 0.20, 0.15};
   EXPECT_TRUE(options.Validate().ok());
@@ -89,6 +89,9 @@ TEST(InputBoundsTest, DetectorOptionsNameTheLevelCheckOutOfRange) {
               HasSubstr("max_below_neighbours_m=-0.01 is outside [0, 1]"));
   options.max_below_neighbours_m = 0.0;
   EXPECT_TRUE(options.Validate().ok()) << "0 turns the check off";
+  options.acceptance.unseen_longer_see_through = 1.5;
+  EXPECT_THAT(std::string(options.Validate().message()),
+              HasSubstr("acceptance.unseen_longer_see_through must be in [0, 1], got 1.5"));
 }
 
 TEST(InputBoundsTest, DetectorRejectsAnAbsurdCameraWithItsField) {

@@ -23,11 +23,13 @@ constexpr char kMovedTooFar[] = "refinement moved it too far: not this box";
 constexpr char kRunsOnFlat[] =
     "a side runs on flat with no seam (a bigger face, or a layer that does not tile uniquely)";
 constexpr char kNotBoxedIn[] = "no free side and not boxed in by seams on all four";
+constexpr char kLongerSide[] = "a hidden side could be a longer side of the box";
 
 }  // namespace
 
 std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, BoxFace grasp,
-                              const AcceptanceOptions& o, int out_of_view_side) {
+                              const AcceptanceOptions& o, int out_of_view_side,
+                              unsigned longer_ruled_out) {
   // The in-plane position must be measured, not guessed: a free side along
   // each of the face's axes.
   const int fi = static_cast<int>(grasp);
@@ -75,10 +77,11 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
     if (!occluded && !unseen) continue;
     const int here = s < 2 ? axis_a : axis_b, other = s < 2 ? axis_b : axis_a;
     for (int k = 0; k < 3; ++k) {
-      if ((k != here && k != other && dims[k] > dims[here] + o.extent_tolerance_m) ||
+      if ((k != here && k != other && dims[k] > dims[here] + o.extent_tolerance_m &&
+           (longer_ruled_out & (1u << s)) == 0) ||
           (occluded && k == other && dims[k] > dims[here] + o.extent_tolerance_m &&
            ref.sides[s < 2 ? 2 : 0] == SideKind::kOccluded)) {
-        return "a hidden side could be a longer side of the box";
+        return kLongerSide;
       }
     }
   }
@@ -87,7 +90,7 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
 
 double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
                     BoxFace grasp, const AcceptanceOptions& o, std::string* reason,
-                    int out_of_view_side) {
+                    int out_of_view_side, unsigned longer_ruled_out) {
   auto reject = [&](std::string why) {
     if (reason != nullptr) *reason = std::move(why);
     return -1.0;
@@ -120,7 +123,8 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
     return reject(absl::StrFormat("%.0f%% of the box hidden: sunk into a surface?",
                                   100.0 * ev.total.occluded / ev.total.expected));
   }
-  if (std::string why = RefinementVerdict(ref, dims, grasp, o, out_of_view_side); !why.empty()) {
+  if (std::string why = RefinementVerdict(ref, dims, grasp, o, out_of_view_side, longer_ruled_out);
+      !why.empty()) {
     return reject(std::move(why));
   }
   return std::clamp(0.5 * grasp_support + 0.5 * ev.support() - 2.0 * ev.see_through_fraction() -
@@ -371,6 +375,41 @@ Eigen::Isometry3d TurnedAtCorner(const Eigen::Isometry3d& camera_T_box, BoxFace 
   return turned;
 }
 
+Eigen::Isometry3d LongerUnderSide(const Eigen::Isometry3d& camera_T_box, BoxFace grasp,
+                                  const BoxDims& dims, int side) {
+  const int axis_n = static_cast<int>(grasp) / 2;
+  const double sign_n = static_cast<int>(grasp) % 2 == 0 ? 1.0 : -1.0;
+  const int here = side < 2 ? (axis_n + 1) % 3 : (axis_n + 2) % 3;
+  const int other = 3 - axis_n - here;
+  const double sign_side = side % 2 == 0 ? 1.0 : -1.0;
+  const double grow = 0.5 * (dims[axis_n] - dims[here]);
+  // In the box's frame: the face runs dims[axis_n] from its opposite side,
+  // the box dims[here] deep behind the face.
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  shift[here] = sign_side * grow;
+  shift[axis_n] = sign_n * grow;
+  Eigen::Isometry3d longer = camera_T_box;
+  longer.translation() += camera_T_box.linear() * shift;
+  longer.linear() =
+      camera_T_box.linear() *
+      Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::Unit(other)).toRotationMatrix();
+  return longer;
+}
+
+unsigned LongerReadingsRuledOut(const DepthImage& depth, const Eigen::Isometry3d& pose,
+                                BoxFace grasp, const RefinementResult& ref,
+                                const DetectorOptions& options) {
+  const double share = options.acceptance.unseen_longer_see_through;
+  unsigned out = 0;
+  for (int s = 0; s < 4 && share > 0.0; ++s) {
+    if (ref.sides[s] != SideKind::kUnknown) continue;
+    const BoxEvidence ev = MeasureBox(depth, LongerUnderSide(pose, grasp, options.box, s),
+                                      options.box, options.evidence);
+    if (ev.see_through_fraction() >= share) out |= 1u << s;
+  }
+  return out;
+}
+
 std::vector<Eigen::Isometry3d> TurnedAtMeasuredCorners(const Eigen::Isometry3d& camera_T_box,
                                                        BoxFace grasp,
                                                        const std::array<SideKind, 4>& sides,
@@ -455,15 +494,22 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, const std::vector<DetectedB
   const int out_of_view = OutOfViewSide(cand.box.camera_T_box, grasp, cand.refinement, in_view);
   // What the refinement alone rejects (most often a side that runs on flat:
   // two thirds of all refined hypotheses) needs no full evidence.
-  if (std::string why =
-          RefinementVerdict(cand.refinement, options_.box, grasp, acceptance, out_of_view);
-      !why.empty()) {
+  unsigned longer_ruled_out = 0;
+  std::string why =
+      RefinementVerdict(cand.refinement, options_.box, grasp, acceptance, out_of_view);
+  if (why == kLongerSide) {
+    longer_ruled_out =
+        LongerReadingsRuledOut(depth_, cand.box.camera_T_box, grasp, cand.refinement, options_);
+    why = RefinementVerdict(cand.refinement, options_.box, grasp, acceptance, out_of_view,
+                            longer_ruled_out);
+  }
+  if (!why.empty()) {
     *reason = std::move(why);
     return false;
   }
   cand.evidence = MeasureBox(depth_, cand.box.camera_T_box, options_.box, options_.evidence);
   const double score = JudgeRefined(cand.evidence, cand.refinement, options_.box, grasp, acceptance,
-                                    reason, out_of_view);
+                                    reason, out_of_view, longer_ruled_out);
   if (score < 0.0) return false;
   if (floor_) {
     if (std::string why = ThroughFloor(cand.box.camera_T_box, options_.box, floor_->normal,
@@ -493,6 +539,10 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, const std::vector<DetectedB
     std::string why =
         second.ok ? RefinementVerdict(second, options_.box, grasp, acceptance, again_out_of_view)
                   : std::string(kMovedTooFar);
+    if (why == kLongerSide) {
+      why = RefinementVerdict(second, options_.box, grasp, acceptance, again_out_of_view,
+                              LongerReadingsRuledOut(depth_, again, grasp, second, options_));
+    }
     if (!why.empty()) {
       *reason = "refined once more from where it was refined, " + why;
       return false;

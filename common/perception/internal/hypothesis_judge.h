@@ -31,8 +31,12 @@ struct Candidate {
 // measured extents and how its sides end): "" when it passes, else why not.
 // `out_of_view_side`: a side of the face out of view that what is in view
 // pins (SideOutOfViewPinned), counted as measured; -1: none.
+// `longer_ruled_out`: bit s set when the depth image rules out that side s,
+// unseen, hides the face running on to the box's third side
+// (LongerUnderSide): that side then leaves the face's size in no doubt.
 std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, BoxFace grasp,
-                              const AcceptanceOptions& o, int out_of_view_side = -1);
+                              const AcceptanceOptions& o, int out_of_view_side = -1,
+                              unsigned longer_ruled_out = 0);
 
 // True when exactly one side of the face runs on flat (kContinues) and the
 // other three end it (free, a seam or tiled).
@@ -43,13 +47,28 @@ bool OneSideOnFlat(const RefinementResult& ref);
 // `reason`, when given, says which test failed.
 double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const BoxDims& dims,
                     BoxFace grasp, const AcceptanceOptions& o, std::string* reason = nullptr,
-                    int out_of_view_side = -1);
+                    int out_of_view_side = -1, unsigned longer_ruled_out = 0);
 
 // The box turned a quarter about its grasp face's normal, flush with the
 // face's corner at (sa, sb) (each +1 or -1 along the face's a and b axes):
 // the other way to read a face from one of its corners.
 Eigen::Isometry3d TurnedAtCorner(const Eigen::Isometry3d& camera_T_box, BoxFace grasp,
                                  const BoxDims& dims, double sa, double sb);
+
+// The box read on a bigger face than its grasp face: side `side` of the
+// grasp face (as RefinementResult::sides) hidden, the face running on under
+// it to the box's third side, the opposite side where it is and the box
+// that side's length deep behind the face.
+Eigen::Isometry3d LongerUnderSide(const Eigen::Isometry3d& camera_T_box, BoxFace grasp,
+                                  const BoxDims& dims, int side);
+
+// The unseen (kUnknown) sides of a refined face whose longer reading
+// (LongerUnderSide) the depth image rules out: at least AcceptanceOptions::
+// unseen_longer_see_through of it seen through (RefinementVerdict's
+// `longer_ruled_out`). Bit s: side s.
+unsigned LongerReadingsRuledOut(const DepthImage& depth, const Eigen::Isometry3d& pose,
+                                BoxFace grasp, const RefinementResult& ref,
+                                const DetectorOptions& options);
 
 // The box turned a quarter at each corner of its grasp face between two
 // measured sides (free or a seam; `sides` as RefinementResult::sides), in
