@@ -56,7 +56,7 @@ struct AcceptanceOptions {
   // nothing.
   bool check_unseen_sides = true;
   // ... unless the depth image rules that longer reading out: at least this
-  // share of the box so read (HypothesisJudge's LongerUnderSide) is seen
+  // share of the box so read (internal::LongerUnderSide) is seen
   // through, the camera seeing the floor past the shadow where the box
   // would be (a brick in a heap, its ends in its own shadows). Four times
   // what a box kept may show (max_see_through). Occluded sides keep the
