@@ -400,9 +400,16 @@ unsigned LongerReadingsRuledOut(const DepthImage& depth, const Eigen::Isometry3d
                                 BoxFace grasp, const RefinementResult& ref,
                                 const DetectorOptions& options) {
   const double share = options.acceptance.unseen_longer_see_through;
+  const int axis_n = static_cast<int>(grasp) / 2;
+  const BoxDims& dims = options.box;
   unsigned out = 0;
   for (int s = 0; s < 4 && share > 0.0; ++s) {
-    if (ref.sides[s] != SideKind::kUnknown) continue;
+    // Only where the box's third side is longer (RefinementVerdict's test).
+    const int here = s < 2 ? (axis_n + 1) % 3 : (axis_n + 2) % 3;
+    if (ref.sides[s] != SideKind::kUnknown ||
+        dims[axis_n] <= dims[here] + options.acceptance.extent_tolerance_m) {
+      continue;
+    }
     const BoxEvidence ev = MeasureBox(depth, LongerUnderSide(pose, grasp, options.box, s),
                                       options.box, options.evidence);
     if (ev.see_through_fraction() >= share) out |= 1u << s;
@@ -495,15 +502,9 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, const std::vector<DetectedB
   // What the refinement alone rejects (most often a side that runs on flat:
   // two thirds of all refined hypotheses) needs no full evidence.
   unsigned longer_ruled_out = 0;
-  std::string why =
-      RefinementVerdict(cand.refinement, options_.box, grasp, acceptance, out_of_view);
-  if (why == kLongerSide) {
-    longer_ruled_out =
-        LongerReadingsRuledOut(depth_, cand.box.camera_T_box, grasp, cand.refinement, options_);
-    why = RefinementVerdict(cand.refinement, options_.box, grasp, acceptance, out_of_view,
-                            longer_ruled_out);
-  }
-  if (!why.empty()) {
+  if (std::string why =
+          Verdict(cand.box.camera_T_box, grasp, cand.refinement, out_of_view, &longer_ruled_out);
+      !why.empty()) {
     *reason = std::move(why);
     return false;
   }
@@ -536,13 +537,10 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, const std::vector<DetectedB
     SeamsAgainstKept(again, grasp, kept, &second);
     const int again_out_of_view = OutOfViewSide(
         again, grasp, second, GraspFaceInView(again, grasp, acceptance.border_margin_px));
-    std::string why =
-        second.ok ? RefinementVerdict(second, options_.box, grasp, acceptance, again_out_of_view)
-                  : std::string(kMovedTooFar);
-    if (why == kLongerSide) {
-      why = RefinementVerdict(second, options_.box, grasp, acceptance, again_out_of_view,
-                              LongerReadingsRuledOut(depth_, again, grasp, second, options_));
-    }
+    unsigned again_ruled_out = 0;
+    const std::string why = second.ok
+                                ? Verdict(again, grasp, second, again_out_of_view, &again_ruled_out)
+                                : std::string(kMovedTooFar);
     if (!why.empty()) {
       *reason = "refined once more from where it was refined, " + why;
       return false;
@@ -564,6 +562,17 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, const std::vector<DetectedB
     return false;
   }
   return true;
+}
+
+std::string HypothesisJudge::Verdict(const Eigen::Isometry3d& pose, BoxFace grasp,
+                                     const RefinementResult& ref, int out_of_view,
+                                     unsigned* longer_ruled_out) const {
+  *longer_ruled_out = 0;
+  std::string why = RefinementVerdict(ref, options_.box, grasp, options_.acceptance, out_of_view);
+  if (why != kLongerSide) return why;
+  *longer_ruled_out = LongerReadingsRuledOut(depth_, pose, grasp, ref, options_);
+  return RefinementVerdict(ref, options_.box, grasp, options_.acceptance, out_of_view,
+                           *longer_ruled_out);
 }
 
 std::optional<Eigen::Vector2d> HypothesisJudge::GraspFacePixel(const Eigen::Isometry3d& pose,

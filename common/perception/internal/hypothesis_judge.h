@@ -182,6 +182,12 @@ class HypothesisJudge {
   // `kept`: the boxes kept so far (SeamsAgainstKept).
   bool EvaluateOne(const Proposal& p, const std::vector<DetectedBox>& kept, Candidate* out,
                    bool* refined, std::string* reason) const;
+  // RefinementVerdict of a refined face at `pose`; where that is a hidden
+  // side a longer side could stand in, again with the longer readings the
+  // depth rules out (LongerReadingsRuledOut, set in *longer_ruled_out for
+  // JudgeRefined).
+  std::string Verdict(const Eigen::Isometry3d& pose, BoxFace grasp, const RefinementResult& ref,
+                      int out_of_view, unsigned* longer_ruled_out) const;
   // A side the refinement found running on flat that lies against a box of
   // `kept` (SideAgainstKeptBox) is a seam: the kept box vouches for it.
   void SeamsAgainstKept(const Eigen::Isometry3d& pose, BoxFace grasp,
