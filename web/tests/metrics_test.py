@@ -65,13 +65,17 @@ def main():
             return value(after, name, **labels) - value(before, name, **labels)
 
         # A call is counted when the server has finished it, which may be a
-        # moment after its client has the answer (a loaded machine): scrape
-        # until the two Detects are in, for up to 10 s.
+        # moment after its client has the answer (a loaded machine): an RPC when
+        # its handler returns, an HTTP request when httplib's logger runs, after
+        # the response is written. Scrape until the two Detects and the 404 are
+        # in, for up to 10 s.
         deadline = time.monotonic() + 10.0
         while True:
             _, after = scrape(s)
-            if moved("cornerpose_rpc_duration_seconds_count", method="Detect") >= 2 or \
-                    time.monotonic() > deadline:
+            counted = moved("cornerpose_rpc_duration_seconds_count", method="Detect") >= 2 and \
+                moved("cornerpose_http_requests_total", route="/api/sources/{name}/latest",
+                      status="404") >= 1
+            if counted or time.monotonic() > deadline:
                 break
             time.sleep(0.1)
 
