@@ -283,8 +283,17 @@ void BucketSort(std::vector<T>* values, double lo, double hi, Key key) {
   out.resize(n);
   next.assign(start.begin(), start.end() - 1);
   for (const T& x : *values) out[next[bucket_of(x)]++] = x;
+  // Each bucket holds a few values: an insertion sort in place (a call to
+  // std::sort per bucket cost more than the sorting). Values equal under <
+  // may come out in another order than std::sort's; they are equal in every
+  // field the readers sum.
   for (size_t b = 0; b < buckets; ++b) {
-    if (start[b + 1] - start[b] > 1) std::sort(out.begin() + start[b], out.begin() + start[b + 1]);
+    for (size_t i = start[b] + 1; i < start[b + 1]; ++i) {
+      T x = out[i];
+      size_t j = i;
+      for (; j > start[b] && x < out[j - 1]; --j) out[j] = out[j - 1];
+      out[j] = x;
+    }
   }
   values->swap(out);
 }
@@ -305,6 +314,8 @@ class SeamScan {
       return std::abs(*along) <= half_other - reach && std::abs(*across) < reach;
     };
     std::vector<Row> rows;
+    rows.reserve(pts.size());
+    expected_.reserve(grid.size());
     for (const FacePoint& p : pts) {
       double across, along;
       if (band(p, &across, &along)) rows.push_back({across, p.n, along});
@@ -327,6 +338,8 @@ class SeamScan {
   // The points of this side with along in [lo, hi).
   SeamScan Stretch(double lo, double hi) const {
     SeamScan part(o_);
+    part.rows_.reserve(rows_.size());
+    part.expected_.reserve(expected_.size());
     for (const Row& r : rows_) {
       if (r.along >= lo && r.along < hi) part.rows_.push_back(r);
     }
@@ -412,7 +425,8 @@ class SeamScan {
     void Build(const std::vector<T>& values, XY xy) {
       const size_t n = values.size();
       x_.resize(n);
-      sum_.assign(n + 1, Sums{});
+      sum_.resize(n + 1);
+      sum_[0] = Sums{};
       for (size_t i = 0; i < n; ++i) {
         const auto [x, y] = xy(values[i]);
         x_[i] = x;
