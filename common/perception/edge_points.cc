@@ -17,6 +17,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/perception/internal/parallel.h"
+#include "common/perception/internal/round_half_away.h"
 #include "common/perception/internal/select_kth.h"
 
 namespace cornerpose {
@@ -257,21 +258,13 @@ class OrganizedScorer {
     return u - r < 0 || v - r < 0 || u + r >= cloud_.width || v + r >= cloud_.height;
   }
 
-  // std::lround for |x| < 2^23, inlined (the library call was most of
-  // OnOccludedSide's time): x - trunc(x) is exact there.
-  static int RoundHalfAway(float x) {
-    const int i = static_cast<int>(x);
-    const float frac = x - static_cast<float>(i);
-    return i + (frac >= 0.5f) - (frac <= -0.5f);
-  }
-
   bool OnOccludedSide(int u, int v, const Eigen::Vector3f& p, float radius_px) const {
     // Past the image's size every offset leaves it; keeps the rounding in int.
     radius_px = std::min(radius_px, static_cast<float>(cloud_.width + cloud_.height));
     const float nearer = p.z() - static_cast<float>(options_.occluded_side_jump_m);
     for (const Eigen::Vector2f& o : pattern_) {
-      const Eigen::Vector3f* q = At(u + RoundHalfAway(o.x() * radius_px),
-                                    v + RoundHalfAway(o.y() * radius_px));
+      const Eigen::Vector3f* q = At(u + internal::RoundHalfAway(o.x() * radius_px),
+                                    v + internal::RoundHalfAway(o.y() * radius_px));
       if (q != nullptr && q->z() < nearer) return true;
     }
     return false;

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/perception/face_proposals.h"
+#include "common/perception/internal/round_half_away.h"
 
 namespace cornerpose {
 namespace {
@@ -206,8 +207,10 @@ std::vector<Eigen::Isometry3d> SeamSplitFaces(const DepthImage& depth, const Pla
   auto pixel_of = [&](const Eigen::Vector3d& p, int* u, int* v) {
     if (p.z() <= 0.05) return false;
     const Eigen::Vector2d px = Project(k, p);
-    *u = static_cast<int>(std::lround(px.x()));
-    *v = static_cast<int>(std::lround(px.y()));
+    // Far outside the image (or not a number): not on it.
+    if (!(std::abs(px.x()) < 1e9 && std::abs(px.y()) < 1e9)) return false;
+    *u = internal::RoundHalfAway(px.x());
+    *v = internal::RoundHalfAway(px.y());
     return depth.inside(*u, *v);
   };
   auto on_patch = [&](const Eigen::Vector3d& p) {

@@ -12,6 +12,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "common/perception/internal/round_half_away.h"
 #include "common/perception/internal/select_kth.h"
 #include "tests/support/scene_generator.h"
 #include "tests/support/scene_kinds.h"
@@ -430,6 +431,29 @@ TEST(EdgePointsTest, OrganizedFrameNeedsAFocalLength) {
                 .status()
                 .code(),
             absl::StatusCode::kInvalidArgument);
+}
+
+// The pixel loops' inlined rounding gives what std::lround gives: at and
+// beside every half, and on random values, floats and doubles.
+TEST(RoundHalfAwayTest, MatchesLround) {
+  for (int q = -8000; q <= 8000; ++q) {
+    const float f = 0.25f * static_cast<float>(q);
+    for (const float x : {f, std::nextafter(f, -1e9f), std::nextafter(f, 1e9f)}) {
+      ASSERT_EQ(internal::RoundHalfAway(x), std::lround(x)) << x;
+    }
+    const double d = 0.25 * q;
+    for (const double x : {d, std::nextafter(d, -1e9), std::nextafter(d, 1e9)}) {
+      ASSERT_EQ(internal::RoundHalfAway(x), std::lround(x)) << x;
+    }
+  }
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> any(-1e6, 1e6);
+  for (int i = 0; i < 100000; ++i) {
+    const double d = any(rng);
+    ASSERT_EQ(internal::RoundHalfAway(d), std::lround(d)) << d;
+    const float f = static_cast<float>(d / 200.0);
+    ASSERT_EQ(internal::RoundHalfAway(f), std::lround(f)) << f;
+  }
 }
 
 }  // namespace
