@@ -13,10 +13,12 @@ namespace {
 
 // Bilinear brightness at a sub-pixel position; NaN outside the image.
 float GreyAt(const DepthImage& image, double u, double v) {
-  const int u0 = static_cast<int>(std::floor(u)), v0 = static_cast<int>(std::floor(v));
-  if (u0 < 0 || v0 < 0 || u0 + 1 >= image.camera.width || v0 + 1 >= image.camera.height) {
+  // The four pixels around (u, v) inside the image: 0 <= u < width - 1 (a
+  // NaN fails it too). The truncation is then floor, without its call.
+  if (!(u >= 0.0 && v >= 0.0 && u < image.camera.width - 1 && v < image.camera.height - 1)) {
     return std::numeric_limits<float>::quiet_NaN();
   }
+  const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
   const double fu = u - u0, fv = v - v0;
   return static_cast<float>(
       (1 - fu) * (1 - fv) * image.grey_at(u0, v0) + fu * (1 - fv) * image.grey_at(u0 + 1, v0) +
