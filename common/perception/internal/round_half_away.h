@@ -2,8 +2,6 @@
 // the time of the loops that round a coordinate per sample.
 #pragma once
 
-#include <cstdint>
-
 namespace cornerpose::internal {
 
 // What std::lround gives (halves away from zero), for |x| < 2^23: x minus
