@@ -1,5 +1,6 @@
 #include "common/perception/clubbing.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -26,6 +27,10 @@ absl::Status ClubbingOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("meet_distance_m=", meet_distance_m, " is outside (0, 0.5] m"));
   }
+  if (!(meet_along_view_factor >= 1.0 && meet_along_view_factor <= 10.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("meet_along_view_factor=", meet_along_view_factor, " is outside [1, 10]"));
+  }
   if (!(end_gap_m >= 0.0 && end_gap_m <= 0.5)) {
     return absl::InvalidArgumentError(
         absl::StrCat("end_gap_m=", end_gap_m, " is outside [0, 0.5] m"));
@@ -50,8 +55,15 @@ bool SegmentsMeet(const std::vector<EdgeSegment>& segments, int a, int b,
   const double ta = (c * e - d) / denom;
   const double tb = (e - c * d) / denom;
   const Eigen::Vector3d qa = pa + ta * da, qb = pb + tb * db;
-  if ((qa - qb).norm() > options.meet_distance_m) return false;
   const Eigen::Vector3d meet = 0.5 * (qa + qb);
+  const Eigen::Vector3d gap = qa - qb;
+  const double view_norm = meet.norm();
+  const double along_view = view_norm > 1e-9 ? gap.dot(meet) / view_norm : 0.0;
+  const double across_view = std::sqrt(std::max(0.0, gap.squaredNorm() - along_view * along_view));
+  if (across_view > options.meet_distance_m ||
+      std::abs(along_view) > options.meet_along_view_factor * options.meet_distance_m) {
+    return false;
+  }
   const double a1 = (sa.end1.cast<double>() - meet).norm(),
                a2 = (sa.end2.cast<double>() - meet).norm();
   const double b1 = (sb.end1.cast<double>() - meet).norm(),

@@ -1,7 +1,8 @@
 // Stage 3: club edge segments of the same box (seed paper Algorithm 2).
 //
 // Two segments belong to one box when they are perpendicular and meet: their
-// lines pass within meet_distance_m of each other, and each segment reaches
+// lines pass within meet_distance_m of each other (further along the line
+// of sight, where the depth noise is), and each segment reaches
 // that meeting point (an extremity within end_gap_m of it). The corner is the
 // meeting point, the mean of the two lines' closest points, which is where
 // the two extremities would meet without the blur of the edge bands.
@@ -22,6 +23,13 @@ struct ClubbingOptions {
   // The two segments' lines must pass this close to each other. Metres.
   // Paper: 0.01.
   double meet_distance_m = 0.01;
+  // ... across the line of sight to their meeting point; along it they may
+  // pass this many times as far apart. The depth noise lies along the ray
+  // (an active stereo camera's, at 1.6 m, puts the two lines of one corner
+  // of a brick 1-3 cm apart in depth), while across it the edge points pin
+  // a line to a few millimetres. The camera sits at the cloud's origin.
+  // 1: the paper's sphere. Unitless, [1, 10].
+  double meet_along_view_factor = 3.0;
   // Each segment's nearer extremity must lie this close to the meeting
   // point; edge bands and fillets keep extremities a little short of the
   // true corner. Metres.

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 namespace cornerpose {
@@ -75,15 +76,62 @@ TEST(SegmentsMeetTest, ParallelSegmentsDoNotMeet) {
 
 TEST(SegmentsMeetTest, PerpendicularLinesThreeCentimetresApartDoNotMeet) {
   const Frame f;
-  // Seen from the camera they cross at the corner, but one lies 3 cm deeper.
+  // Seen from the camera they cross at the corner, but one lies 3 cm off
+  // along the face's normal, 28 degrees from the line of sight: 1.4 cm
+  // across it, more than meet_distance_m.
   const std::vector<EdgeSegment> segments = {MakeSegment(f.At(0, 0), f.At(0.3, 0)),
                                              MakeSegment(f.At(0, 0, 0.03), f.At(0, 0.2, 0.03))};
+  ASSERT_NEAR(f.n().dot(f.origin.normalized()), 0.884, 0.01);
   Corner corner;
   EXPECT_FALSE(SegmentsMeet(segments, 0, 1, ClubbingOptions{}, &corner));
   // Within meet_distance_m they would.
   ClubbingOptions loose;
   loose.meet_distance_m = 0.035;
   EXPECT_TRUE(SegmentsMeet(segments, 0, 1, loose, &corner));
+}
+
+TEST(SegmentsMeetTest, DepthNoiseAlongTheLineOfSightStillMeets) {
+  // A face seen head on: its normal along the line of sight to the corner,
+  // where an active stereo camera's depth noise puts one edge's line 2 cm
+  // behind the other's.
+  const Eigen::Vector3d corner_at(0.2, -0.1, 1.6);
+  const Eigen::Vector3d n = -corner_at.normalized();
+  const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+  const std::vector<EdgeSegment> segments = {
+      MakeSegment(corner_at + 0.01 * u, corner_at + 0.19 * u),
+      MakeSegment(corner_at - 0.02 * n + 0.01 * v, corner_at - 0.02 * n + 0.09 * v)};
+  Corner corner;
+  ASSERT_TRUE(SegmentsMeet(segments, 0, 1, ClubbingOptions{}, &corner));
+  EXPECT_LT((corner.position.cast<double>() - (corner_at - 0.01 * n)).norm(), 0.002);
+  // The paper's sphere (factor 1) does not take it; 4 cm apart, past three
+  // times meet_distance_m, neither does the default.
+  ClubbingOptions sphere;
+  sphere.meet_along_view_factor = 1.0;
+  EXPECT_FALSE(SegmentsMeet(segments, 0, 1, sphere, &corner));
+  const std::vector<EdgeSegment> far = {
+      segments[0], MakeSegment(corner_at - 0.04 * n + 0.01 * v, corner_at - 0.04 * n + 0.09 * v)};
+  EXPECT_FALSE(SegmentsMeet(far, 0, 1, ClubbingOptions{}, &corner));
+}
+
+TEST(SegmentsMeetTest, AGapAcrossTheLineOfSightIsNotDepthNoise) {
+  // A face seen edge on (its normal across the line of sight): 2 cm along
+  // the normal is 2 cm across the view, and the lines do not meet.
+  const Eigen::Vector3d corner_at(0.0, 0.0, 1.5);
+  const Eigen::Vector3d n = Eigen::Vector3d::UnitX(), u = Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d v = n.cross(u);
+  const std::vector<EdgeSegment> segments = {
+      MakeSegment(corner_at + 0.01 * u, corner_at + 0.19 * u),
+      MakeSegment(corner_at + 0.02 * n + 0.01 * v, corner_at + 0.02 * n + 0.09 * v)};
+  Corner corner;
+  EXPECT_FALSE(SegmentsMeet(segments, 0, 1, ClubbingOptions{}, &corner));
+}
+
+TEST(ClubbingOptionsTest, ValidateNamesTheAlongViewFactor) {
+  ClubbingOptions o;
+  o.meet_along_view_factor = 0.5;
+  const absl::Status s = o.Validate();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("meet_along_view_factor"), std::string::npos) << s;
 }
 
 TEST(SegmentsMeetTest, LinesThatCrossFarFromBothEndsDoNotMeet) {
