@@ -692,23 +692,29 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
   if (outer > o.free_side_ratio * inner) {
     // The face continues past the side: a seam to a touching box, or the
     // hypothesis is too small for this face.
+    // ... or only its rim does, ending within the band: where it ends, for
+    // RimAsFree to decide. Measured for a seam too: one the colour image
+    // or the outward search's rule drops again (ConfirmSeamInColour,
+    // OutwardSeamsNeedEverySide) leaves a side that runs on, and a stereo
+    // camera's fattened rim reads as a groove just past its edge.
+    auto rim = [&] {
+      if (!o.rim_ends_side) return;
+      SideMeasure end;
+      if (measure_end(&end)) {
+        m.rim_position = end.position;
+        m.rim_slope = end.slope;
+        m.rim = true;
+      }
+    };
     if (std::optional<double> seam =
             FindSeam(pts, grid, along_a, sign, half, half_other, pixel_m, o, &m.seam_slope)) {
       m.kind = SideKind::kSeam;
       m.position = *seam;
       m.outward_seam = *seam - half > o.seam_search_m - 0.0015;
+      rim();
     } else {
       m.kind = SideKind::kContinues;
-      // ... or only its rim does, ending within the band: where it ends,
-      // for RimAsFree to decide.
-      if (o.rim_ends_side) {
-        SideMeasure end;
-        if (measure_end(&end)) {
-          m.rim_position = end.position;
-          m.rim_slope = end.slope;
-          m.rim = true;
-        }
-      }
+      rim();
     }
     return m;
   }

@@ -431,6 +431,48 @@ TEST(RefineOnGraspFaceTest, AFaceARimTooLongEndsWhereItsPointsEnd) {
   EXPECT_EQ(r_off.sides[0], SideKind::kContinues);
 }
 
+// The same carton with a groove in its rim (a line of missing returns 3-6
+// mm past the reading's side, as an active stereo camera's noise leaves in
+// a fattened edge) and a colour image that shows the carton but no line
+// there: the groove is no seam (colour_confirms_seam), and the side is
+// what it would be without it, a rim that ends 12 mm out: free.
+TEST(RefineOnGraspFaceTest, AGrooveTheColourDropsInARimLeavesTheRim) {
+  const BoxDims bulging{kCartonS.l + 0.012, kCartonS.b, kCartonS.h};
+  FlatScene s = RenderFlat({Flat(bulging, 0.0, 0.0)});
+  const GroundTruthBox& gt = s.rendered.boxes[0];
+  const Eigen::Isometry3d flush = Moved(gt.camera_T_box, -0.006, 0.0, 0.0);
+  const Eigen::Isometry3d box_T_camera = flush.inverse();
+  const int w = s.depth.camera.width, h = s.depth.camera.height;
+  s.depth.grey.assign(static_cast<size_t>(w) * h, 90.0f);
+  int grooved = 0;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      float& z = s.depth.z[static_cast<size_t>(v) * w + u];
+      if (std::isnan(z)) continue;
+      const Eigen::Vector3d p = box_T_camera * (z * PixelRay(s.depth.camera, u, v));
+      if (p.z() < kCartonS.h / 2 - 0.01) continue;  // the top face only
+      s.depth.grey[static_cast<size_t>(v) * w + u] = 150.0f;
+      if (p.x() > kCartonS.l / 2 + 0.003 && p.x() < kCartonS.l / 2 + 0.006) {
+        z = std::numeric_limits<float>::quiet_NaN();
+        ++grooved;
+      }
+    }
+  }
+  ASSERT_GT(grooved, 50);
+  Eigen::Isometry3d pose = flush;
+  const RefinementResult r =
+      RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), RefinementOptions{}, &pose);
+  ASSERT_TRUE(r.ok);
+  for (SideKind k : r.sides) EXPECT_EQ(k, SideKind::kFree);
+  EXPECT_LT(ComparePoses(pose, gt.camera_T_box, bulging).translation_m, 0.004);
+  // Without the colour rule the groove is a seam, where the face is read.
+  RefinementOptions depth_only;
+  depth_only.colour_confirms_seam = 0.0;
+  pose = flush;
+  EXPECT_EQ(RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), depth_only, &pose).sides[0],
+            SideKind::kSeam);
+}
+
 // The rim rule does not make a box of another size this one: a face whose
 // other axis is 3 cm short of the box, or that runs on 4 cm (past the band a
 // side is read in), keeps a side that runs on.
