@@ -47,6 +47,8 @@ constexpr char kHelp[] =
     "  --samples N          neighbours sampled per point, 0 = all (64)\n"
     "  --ransac_threshold M RANSAC line inlier distance (0.01)\n"
     "  --meet_distance M    corner: largest distance between two edges' lines (0.01)\n"
+    "  --meet_along_view F  ... along the line of sight F times that (depth noise; 3;\n"
+    "                       1: the paper's sphere)\n"
     "  --coarse_step N      organized frames: score 1 pixel in N x N first, then only\n"
     "                       pixels near a hit; 1 = every pixel (3)\n"
     "  --lattice_radius PX  organized frames: the edge stage scores every k-th pixel,\n"
@@ -72,9 +74,11 @@ constexpr char kHelp[] =
     "  --seen_through S     a reading with no point just inside one side, where that\n"
     "                       share of the pixels there not hidden see behind its plane,\n"
     "                       is declined: the face ends before that side (0.4; 0: off)\n"
-    "  --level_check M      a box whose top is level with a box beside it but whose\n"
-    "                       bottom would lie more than M below that one's is taken\n"
-    "                       out (0.05; 0: off)\n"
+    "  --level_check M      a box whose top is level with two boxes beside it (a\n"
+    "                       layer) but whose bottom would lie more than M below\n"
+    "                       theirs is taken out (0.05; 0: off)\n"
+    "  --flush_layer BOOL   ... or with one it lies flush against, touching and\n"
+    "                       aligned (true)\n"
     "  --turned_check BOOL  a box with a side not measured is taken out when its face\n"
     "                       turned a quarter at a measured corner is a box too (true)\n"
     "  --retake_outranked BOOL a box a check took out no longer blocks the readings\n"
@@ -106,6 +110,8 @@ constexpr char kHelp[] =
     "                       boxes; true for cells that see only layers of known boxes)\n"
     "  --size_tolerance M   how far a box may be off its nominal size and still be it\n"
     "                       (unset: each stage's own tolerance, 1-2.5 cm)\n"
+    "  --short_both M       a face measured short of the box by more than M on both\n"
+    "                       axes is a smaller box (0.012; --size_tolerance T: T; 0: off)\n"
     "  --side_allowance M   on a box's faces but the one it shows most, depth up to M\n"
     "                       behind the tolerance is no evidence either way (time-of-\n"
     "                       flight multipath in concave creases; 0.025; 0: off)\n"
@@ -179,6 +185,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetInt("samples", &options.edge_points.max_samples),
         args.SetDouble("ransac_threshold", &options.segments.ransac_threshold_m),
         args.SetDouble("meet_distance", &options.clubbing.meet_distance_m),
+        args.SetDouble("meet_along_view", &options.clubbing.meet_along_view_factor),
         args.SetInt("threads", &options.num_threads),
         args.SetInt("coarse_step", &options.edge_points.coarse_step),
         args.SetDouble("lattice_radius", &options.edge_lattice_radius_px),
@@ -187,6 +194,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("layer_check", &options.faces.check_layer_tiling),
         args.SetBool("floor_check", &options.floor_check),
         args.SetDouble("level_check", &options.max_below_neighbours_m),
+        args.SetBool("flush_layer", &options.flush_neighbour_is_layer),
         args.SetBool("turned_check", &options.turned_check),
         args.SetBool("retake_outranked", &options.retake_outranked),
         args.SetBool("unseen_sides", &options.acceptance.check_unseen_sides),
@@ -222,7 +230,8 @@ absl::Status Run(const CommandArgs& args) {
         args.SetDouble("seam_outward", &options.refinement.seam_search_outward_m),
         args.SetBool("retry_declined", &options.retry_declined),
         args.SetInt("patch_window", &options.faces.patches.window_cells),
-        args.SetDouble("side_allowance", &options.evidence.side_face_allowance_m)}) {
+        args.SetDouble("side_allowance", &options.evidence.side_face_allowance_m),
+        args.SetDouble("short_both", &options.acceptance.max_short_both_axes_m)}) {
     if (!s.ok()) return s;
   }
   if (get("size_tolerance")) {
@@ -303,6 +312,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "samples",
                                                        "ransac_threshold",
                                                        "meet_distance",
+                                                       "meet_along_view",
                                                        "threads",
                                                        "coarse_step",
                                                        "lattice_radius",
@@ -312,6 +322,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "layer_check",
                                                        "floor_check",
                                                        "level_check",
+                                                       "flush_layer",
                                                        "turned_check",
                                                        "retake_outranked",
                                                        "unseen_sides",
@@ -327,6 +338,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "size_tolerance",
                                                        "max_declined",
                                                        "side_allowance",
+                                                       "short_both",
                                                        "border_faces",
                                                        "leaving_view",
                                                        "out_of_view",

@@ -61,6 +61,7 @@ void ApplySizeTolerance(double t, DetectorOptions* o) {
   o->refinement.tile_tolerance_m = 2.0 * t / 3.0;
   o->pose.length_tolerance_m = t + 0.01;
   o->acceptance.extent_tolerance_m = t + 0.01;
+  o->acceptance.max_short_both_axes_m = t;
 }
 
 // What the refinement measured of a kept box's grasp face, for the checks
@@ -175,8 +176,9 @@ std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptio
 // their tops level with its own (DetectorOptions::max_below_neighbours_m),
 // its bottom cannot lie far below theirs, in a hole of what they stand on.
 // It takes two such neighbours, a layer: beside one box lying on another in
-// a heap, a box on end stands as level with it. True when a box was taken
-// out.
+// a heap, a box on end stands as level with it; or one it lies flush
+// against (DetectorOptions::flush_neighbour_is_layer). True when a box was
+// taken out.
 bool CheckStandsLevel(const DetectorOptions& options, std::vector<DetectedBox>* boxes,
                       std::vector<KeptReading>* readings,
                       std::vector<DeclinedCandidate>* declined) {
@@ -213,7 +215,14 @@ bool CheckStandsLevel(const DetectorOptions& options, std::vector<DetectedBox>* 
       }
       const double below = height(b) - above - height(nb);  // b's bottom below nb's
       if (below <= tol) continue;
-      ++level;
+      // A neighbour that one of its sides lies against (touching, aligned:
+      // SideAgainstKeptBox) is a layer on its own: boxes of a heap do not
+      // meet flush along a whole side.
+      bool flush = false;
+      for (int s = 0; s < 4 && !flush && options.flush_neighbour_is_layer; ++s) {
+        flush = internal::SideAgainstKeptBox(b.camera_T_box, b.grasp_face, d, s, {nb});
+      }
+      level += flush ? kLayerNeighbours : 1;
       deepest = std::max(deepest, below);
     }
     if (level < kLayerNeighbours) return "";
@@ -410,6 +419,7 @@ absl::Status AcceptanceOptions::Validate() const {
            CheckRange("acceptance.unseen_longer_see_through", unseen_longer_see_through, 0.0, 1.0),
            CheckRange("acceptance.min_grasp_pixels", min_grasp_pixels, 1, 1'000'000),
            CheckPositive("acceptance.extent_tolerance_m", extent_tolerance_m, 1.0),
+           CheckRange("acceptance.max_short_both_axes_m", max_short_both_axes_m, 0.0, 1.0),
            CheckRange("acceptance.max_grasp_view_angle_deg", max_grasp_view_angle_deg, 0.0, 90.0),
            CheckRange("acceptance.border_margin_px", border_margin_px, 0.0, 1000.0),
            CheckRange("acceptance.leaving_view_free_axes", leaving_view_free_axes, 0, 2),

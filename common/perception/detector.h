@@ -48,6 +48,14 @@ struct AcceptanceOptions {
   // A face measured between two free sides must match its known size within
   // this. Metres.
   double extent_tolerance_m = 0.025;
+  // ... and a face so measured on both axes that is short of the box on
+  // both by more than this is a box of another size (a smaller box whose
+  // top lies within extent_tolerance_m of this box's face each way, read
+  // as this one on end). Cartons bulge more than they shrink, and edge
+  // bands make a face read long: over the 78 evaluation sets no box found
+  // right was more than 6 mm short on both axes. With
+  // DetectorOptions::size_tolerance_m set, that tolerance. Metres; 0: off.
+  double max_short_both_axes_m = 0.012;
   // A side of the grasp face with nothing seen near it (kUnknown: a shadow's
   // missing returns) may hide more face, as an occluded side does: the box
   // is declined when a longer side of the box could stand in there (a
@@ -176,6 +184,13 @@ struct DetectorOptions {
   // faces (a smaller box in a layer of flat cartons read as a carton on
   // end). 0 turns the check off. Metres.
   double max_below_neighbours_m = 0.05;
+  // ... and one such box that a side of it lies against (touching, its
+  // sides aligned: internal::SideAgainstKeptBox) is a layer on its own:
+  // boxes in a heap do not meet flush along a whole side. The carton_flat
+  // (0.30 x 0.20 x 0.10 m) lying flat with a tape edge halfway across its
+  // top reads as one on its side beside its single neighbour. False: two
+  // neighbours always.
+  bool flush_neighbour_is_layer = true;
   // A box with a side its refinement did not measure (tiled, running on,
   // hidden) is taken out when its grasp face turned a quarter about its
   // normal, at one of its corners between two measured sides (free or a

@@ -457,6 +457,35 @@ TEST(RefinementVerdictTest, AnUnseenSideWhereALongerSideCouldStandIsDeclined) {
   EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusZ, o), "");
 }
 
+// A face measured between free sides on both axes and short of the box on
+// both by more than max_short_both_axes_m is a smaller box whose top is
+// within the extent tolerance of this box's face each way (a 0.18 x 0.13 m
+// distractor read as a carton_s on its 0.20 x 0.15 end). Short on one axis
+// only (a crushed corner), or by less, it is the box.
+TEST(RefinementVerdictTest, AFaceShortOfTheBoxBothWaysIsASmallerBox) {
+  RefinementResult ref;
+  ref.ok = true;
+  ref.sides = {SideKind::kFree, SideKind::kFree, SideKind::kFree, SideKind::kFree};
+  ref.free_sides = 4;
+  // +x face: its a axis is the box's y (0.20), its b axis the box's z (0.15).
+  ref.extent_a_m = 0.186;
+  ref.extent_b_m = 0.128;
+  AcceptanceOptions o;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusX, o)
+                .rfind("face measures 0.186 x 0.128 m, short of the box's 0.200 x 0.150 m", 0),
+            0u);
+  ref.extent_a_m = 0.195;  // one axis within 12 mm
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusX, o), "");
+  ref.extent_a_m = 0.186;
+  ref.extent_b_m = 0.0;  // the b axis not measured between free sides
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusX, o), "");
+  ref.extent_b_m = 0.128;
+  o.max_short_both_axes_m = 0.0;  // off
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusX, o), "");
+  o.max_short_both_axes_m = -0.01;
+  EXPECT_NE(o.Validate().message().find("acceptance.max_short_both_axes_m"), std::string::npos);
+}
+
 // The longer reading under side 2 of a carton_s read on its +x end face
 // (0.20 x 0.15; side 2 ends its 0.15 axis): the face runs on from side 3
 // to the box's third side (0.30), the box 0.15 deep behind it.

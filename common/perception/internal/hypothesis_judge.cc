@@ -40,6 +40,13 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
       return absl::StrFormat("face measures %.3f m where the box is %.3f m", extent, dims[axis]);
     }
   }
+  if (o.max_short_both_axes_m > 0.0 && ref.extent_a_m > 0.0 && ref.extent_b_m > 0.0 &&
+      dims[axis_a] - ref.extent_a_m > o.max_short_both_axes_m &&
+      dims[axis_b] - ref.extent_b_m > o.max_short_both_axes_m) {
+    return absl::StrFormat(
+        "face measures %.3f x %.3f m, short of the box's %.3f x %.3f m both ways: a smaller box?",
+        ref.extent_a_m, ref.extent_b_m, dims[axis_a], dims[axis_b]);
+  }
   // Every side that can be seen must end the face: a free border or a seam
   // to a touching box. A face that runs on flat is a bigger face.
   int measured = 0;
