@@ -81,6 +81,9 @@ constexpr char kHelp[] =
     "                       aligned (true)\n"
     "  --turned_check BOOL  a box with a side not measured is taken out when its face\n"
     "                       turned a quarter at a measured corner is a box too (true)\n"
+    "  --shifted_check BOOL a box seamed on both sides of an axis is taken out when\n"
+    "                       its face shifted half its width is a box with more free\n"
+    "                       sides (tape edges taken for seams; true)\n"
     "  --retake_outranked BOOL a box a check took out no longer blocks the readings\n"
     "                       it outranked: they are judged again (true)\n"
     "  --turned_proposals BOOL  a hypothesis declined for a side on flat proposes its\n"
@@ -196,6 +199,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetDouble("level_check", &options.max_below_neighbours_m),
         args.SetBool("flush_layer", &options.flush_neighbour_is_layer),
         args.SetBool("turned_check", &options.turned_check),
+        args.SetBool("shifted_check", &options.shifted_check),
         args.SetBool("retake_outranked", &options.retake_outranked),
         args.SetBool("unseen_sides", &options.acceptance.check_unseen_sides),
         args.SetDouble("unseen_longer", &options.acceptance.unseen_longer_see_through),
@@ -324,6 +328,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "level_check",
                                                        "flush_layer",
                                                        "turned_check",
+                                                       "shifted_check",
                                                        "retake_outranked",
                                                        "unseen_sides",
                                                        "unseen_longer",

@@ -349,6 +349,70 @@ bool CheckTurnedReadings(const internal::HypothesisJudge& judge, const DetectorO
   });
 }
 
+// DetectorOptions::shifted_check: a box seamed on both sides of an axis,
+// with fewer than two free sides, whose face shifted half its width along
+// that axis is judged a box with more free sides, is taken out; a shifted
+// reading on another box kept is not judged. `cleared` as for
+// CheckTurnedReadings; the shifted readings judged on every thread, a box
+// to a task.
+bool CheckShiftedReadings(const internal::HypothesisJudge& judge, const DetectorOptions& options,
+                          std::vector<DetectedBox>* boxes, std::vector<KeptReading>* readings,
+                          std::vector<DeclinedCandidate>* declined,
+                          std::vector<Eigen::Isometry3d>* cleared) {
+  auto free_sides = [](const std::array<SideKind, 4>& s) {
+    return static_cast<int>(std::count(s.begin(), s.end(), SideKind::kFree));
+  };
+  const int n = static_cast<int>(boxes->size());
+  std::vector<uint8_t> checked(n, 0), shifted(n, 0);
+  for (int i = 0; i < n; ++i) {
+    const std::array<SideKind, 4>& s = (*readings)[i].sides;
+    const bool seamed_a = s[0] == SideKind::kSeam && s[1] == SideKind::kSeam;
+    const bool seamed_b = s[2] == SideKind::kSeam && s[3] == SideKind::kSeam;
+    if ((!seamed_a && !seamed_b) || free_sides(s) >= 2) continue;
+    const Eigen::Isometry3d& T = (*boxes)[i].camera_T_box;
+    checked[i] = std::none_of(cleared->begin(), cleared->end(), [&](const Eigen::Isometry3d& c) {
+      return (c.translation() - T.translation()).norm() < 1e-4 && c.linear().isApprox(T.linear());
+    });
+  }
+  internal::ParallelForChunks(n, 1, options.num_threads, [&](int, int i, int) {
+    if (!checked[i]) return;
+    const DetectedBox& box = (*boxes)[i];
+    const std::array<SideKind, 4>& s = (*readings)[i].sides;
+    const int axis_n = static_cast<int>(box.grasp_face) / 2;
+    for (int side_pair = 0; side_pair < 2; ++side_pair) {
+      if (s[2 * side_pair] != SideKind::kSeam || s[2 * side_pair + 1] != SideKind::kSeam) continue;
+      const int axis = side_pair == 0 ? (axis_n + 1) % 3 : (axis_n + 2) % 3;
+      const Eigen::Vector3d along = box.camera_T_box.linear().col(axis);
+      for (const double sign : {1.0, -1.0}) {
+        Eigen::Isometry3d pose = box.camera_T_box;
+        pose.translation() += sign * 0.5 * options.box[axis] * along;
+        // Where another box kept lies, the shifted reading contradicts it:
+        // on a layer found right, every inner box's shift (most of the
+        // check's cost) stops here.
+        const bool on_kept = std::any_of(boxes->begin(), boxes->end(), [&](const DetectedBox& k) {
+          return &k != &box && internal::BoxesOverlap(k.camera_T_box, pose, options.box,
+                                                      options.acceptance.overlap_margin_m);
+        });
+        if (on_kept) continue;
+        const std::optional<internal::Candidate> c = judge.JudgeAlone(pose);
+        if (c && free_sides(c->refinement.sides) > free_sides(s)) {
+          shifted[i] = 1;
+          return;
+        }
+      }
+    }
+  });
+  return TakeOut(boxes, readings, declined, [&](size_t i) -> std::string {
+    if (!checked[i]) return "";
+    if (shifted[i]) {
+      return "its face shifted half its width across its two seams is a box ended by more free "
+             "sides (lines inside two faces taken for seams?): declined";
+    }
+    cleared->push_back((*boxes)[i].camera_T_box);
+    return "";
+  });
+}
+
 // The strongest declined hypotheses: none that overlaps a returned box (a
 // variant of it) or a stronger declined one.
 std::vector<DeclinedCandidate> StrongestDeclined(std::vector<DeclinedCandidate> all,
@@ -901,7 +965,8 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
   }
   acceptance->AcceptAll();
   acceptance->AcceptPairsAndTheirs();
-  std::vector<Eigen::Isometry3d> cleared;  // CheckTurnedReadings
+  std::vector<Eigen::Isometry3d> cleared;          // CheckTurnedReadings
+  std::vector<Eigen::Isometry3d> cleared_shifted;  // CheckShiftedReadings
   auto check = [&] {
     const bool layer_removed =
         options.faces.check_layer_tiling &&
@@ -914,7 +979,11 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
     const bool turned_removed =
         options.turned_check && CheckTurnedReadings(*judge, options, &det->boxes,
                                                     acceptance->readings(), declined, &cleared);
-    return layer_removed || level_removed || gaps_removed || turned_removed;
+    const bool shifted_removed =
+        options.shifted_check &&
+        CheckShiftedReadings(*judge, options, &det->boxes, acceptance->readings(), declined,
+                             &cleared_shifted);
+    return layer_removed || level_removed || gaps_removed || turned_removed || shifted_removed;
   };
   for (int round = 0; round < 3 && check(); ++round) {
     for (const LayerTiles& layer : faces.layers) {

@@ -198,6 +198,14 @@ struct DetectorOptions {
   // cannot separate (a tape edge taken for a seam makes a carton turned
   // across two). Faces whose sides differ by less than 2 cm are skipped.
   bool turned_check = true;
+  // A box whose face is bounded by seams on both sides of one axis, with
+  // fewer than two free sides, is taken out when its face shifted half its
+  // width along that axis is judged a box with more free sides: the seams
+  // were lines inside two faces (the tape along the middle of two cartons'
+  // flaps frames a carton straddling them), and the shifted reading, ended
+  // by the layer's edge, is the box. The retaken readings then get their
+  // turn (retake_outranked).
+  bool shifted_check = true;
   // A hypothesis the judge accepted that a box kept before it overlapped
   // (it ranked below it) is judged again, and kept when it passes, once a
   // plausibility check (layer, level, gaps, turned readings) has

@@ -1100,6 +1100,10 @@ TEST(RegressionTest, ABoxOnItsSideFlushAgainstALevelBoxIsTakenOut) {
     DetectorOptions options;
     options.box = carton_flat;
     options.flush_neighbour_is_layer = flush;
+    // As the rule was made (since then the shifted check and a lower
+    // side_ends_share change which reading of the layer is kept first).
+    options.refinement.side_ends_share = 0.67;
+    options.shifted_check = false;
     const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
     ASSERT_TRUE(det.ok()) << det.status();
     EXPECT_GE(det->boxes.size(), 10u) << "rule " << flush;
@@ -1109,6 +1113,39 @@ TEST(RegressionTest, ABoxOnItsSideFlushAgainstALevelBoxIsTakenOut) {
       EXPECT_GE(WrongBoxes(*det, r), 1) << "without the rule the carton on its side is returned";
     }
   }
+}
+
+// Was: on the same stereo carton_flat pallet, with a side read free where
+// the face ends along 0.55 of it (RefinementOptions::side_ends_share), a
+// carton straddling two was returned: its long sides the tape edges along
+// the middle of both cartons' flaps (colour lines), one end the pallet's
+// edge. Shifted half its width across those two seams it is the carton
+// ended by the pallet's edge on two sides, judged a box with more free
+// sides: it is taken out (DetectorOptions::shifted_check), and the two
+// cartons it outranked are kept.
+TEST(RegressionTest, ACartonStraddlingTwoOnTheirTapeEdgesIsTakenOut) {
+  const BoxDims carton_flat{0.30, 0.20, 0.10};
+  const absl::StatusOr<RenderedScene> frame =
+      SensorFrame(SensorKind::kStereo, true, "touching1", carton_flat, 2, 65002);
+  ASSERT_TRUE(frame.ok()) << frame.status();
+  const RenderedScene& r = *frame;
+  const PointCloud cloud = RoundedToMillimetres(r);
+  std::array<size_t, 2> found{};
+  for (const bool check : {true, false}) {
+    DetectorOptions options;
+    options.box = carton_flat;
+    options.refinement.side_ends_share = 0.55;
+    options.shifted_check = check;
+    const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
+    ASSERT_TRUE(det.ok()) << det.status();
+    found[check] = det->boxes.size();
+    if (check) {
+      EXPECT_EQ(WrongBoxes(*det, r), 0);
+    } else {
+      EXPECT_GE(WrongBoxes(*det, r), 1) << "without the check the straddling carton is returned";
+    }
+  }
+  EXPECT_GT(found[1], found[0]);
 }
 
 }  // namespace
