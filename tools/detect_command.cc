@@ -138,7 +138,7 @@ constexpr char kHelp[] =
     "  --rim_sides BOOL     a side where the face runs on but ends within 2 cm is free\n"
     "                       there, when it is the face's only side in doubt (true)\n"
     "  --side_ends SHARE    a side where the face ends within 5 mm along SHARE of it\n"
-    "                       is free, whatever lies flat past the rest (0.67; 0: off)\n"
+    "                       is free, whatever lies flat past the rest (0.55; 0: off)\n"
     "  --anchored_faces BOOL a planar patch that does not tile (an L of box tops, a\n"
     "                       layer cut by the border) proposes a face in each of its\n"
     "                       corners (false)\n"

@@ -97,12 +97,13 @@ struct RefinementOptions {
   // crossing the plane at one corner; a box beside it set off by most of a
   // side). The side is then where the face ends along those stretches.
   // A face that runs on (a bigger face, a layer) does so along all of the
-  // side. 0.55 found 12 more heap boxes over the 78 evaluation sets (no
-  // wrong one there once DetectorOptions::shifted_check took out a carton
-  // straddling two), but on a noisy stereo floor at 2.4 m (no colour) a
-  // face on bare floor ended along 0.55 of its sides and was returned.
-  // 0: off (the side runs on, or is a seam). Unitless.
-  double side_ends_share = 0.67;
+  // side. 0.67 until session 28; 0.55 found 12 more heap boxes over the
+  // 78 evaluation sets, and no wrong one once DetectorOptions::
+  // shifted_check took out a carton straddling two and the floor of a
+  // noisy stereo frame was found (floor_max_beyond_share): a face on that
+  // bare floor ended along 0.55 of its sides. 0: off (the side runs on, or
+  // is a seam). Unitless.
+  double side_ends_share = 0.55;
   // A seam found along a side whose stretch (its length less a band at
   // each end) is at least this long turns the face as a free side does:
   // by where each half of the side has the seam. Seams along shorter

@@ -28,7 +28,9 @@ struct ClubbingOptions {
   // (an active stereo camera's, at 1.6 m, puts the two lines of one corner
   // of a brick 1-3 cm apart in depth), while across it the edge points pin
   // a line to a few millimetres. The camera sits at the cloud's origin.
-  // 1: the paper's sphere. Unitless, [1, 10].
+  // The detector keeps it only for frames with a registered colour image
+  // (DetectBoxes: without one, 1 unless the caller set it). 1: the paper's
+  // sphere. Unitless, [1, 10].
   double meet_along_view_factor = 3.0;
   // Each segment's nearer extremity must lie this close to the meeting
   // point; edge bands and fillets keep extremities a little short of the

@@ -96,7 +96,7 @@ bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<KeptReading>* readings
 // on one plane, together at least floor_min_area_m2 and three of the box's
 // largest faces, whose plane lies farthest from the camera along its
 // normal: the floor or table under a pallet, a heap or a bin), with no more
-// than 1 % of the frame beyond it (past floor_tolerance_m, or three times
+// than floor_max_beyond_share of the frame beyond it (past floor_tolerance_m, or three times
 // the floor's own scatter scaled by z^2 to the point's depth). Found once a
 // frame, before any hypothesis is judged (HypothesisJudge::SetFloor).
 struct FloorPlane {
@@ -168,7 +168,7 @@ std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptio
       beyond += -floor->normal.dot(p - floor->centroid) > limit;
     }
   }
-  if (seen == 0 || beyond > 0.01 * seen) return std::nullopt;
+  if (seen == 0 || beyond > options.floor_max_beyond_share * seen) return std::nullopt;
   return floor;
 }
 
@@ -440,6 +440,24 @@ std::vector<DeclinedCandidate> StrongestDeclined(std::vector<DeclinedCandidate> 
 
 }  // namespace
 
+namespace {
+
+// Whether the frame's grey image varies by at least `min_contrast` levels
+// (every 4th pixel of every 4th row read).
+bool ColourShowsSomething(const DepthImage& depth, double min_contrast) {
+  if (!depth.has_grey()) return false;
+  float lo = 255.0f, hi = 0.0f;
+  for (int v = 0; v < depth.camera.height; v += 4) {
+    for (int u = 0; u < depth.camera.width; u += 4) {
+      lo = std::min(lo, depth.grey_at(u, v));
+      hi = std::max(hi, depth.grey_at(u, v));
+    }
+  }
+  return hi - lo >= min_contrast;
+}
+
+}  // namespace
+
 void DeriveGeometryParameters(double z, double focal_px, DetectorOptions* o) {
   const DetectorOptions defaults;
   const double smallest = std::min({o->box.l, o->box.b, o->box.h});
@@ -510,6 +528,10 @@ absl::Status DetectorOptions::Validate() const {
   if (!(floor_tolerance_m > 0.0 && floor_tolerance_m <= 0.5)) {
     return absl::InvalidArgumentError(
         absl::StrCat("floor_tolerance_m=", floor_tolerance_m, " is outside (0, 0.5]"));
+  }
+  if (!(floor_max_beyond_share >= 0.0 && floor_max_beyond_share <= 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("floor_max_beyond_share=", floor_max_beyond_share, " is outside [0, 1]"));
   }
   if (!(max_below_neighbours_m >= 0.0 && max_below_neighbours_m <= 1.0)) {
     return absl::InvalidArgumentError(
@@ -639,6 +661,18 @@ absl::Status PrepareFrame(const PointCloud& input, const DetectorOptions& option
   f->depth = MakeDepthImage(*f->work, f->camera);
   const double median_z = MedianDepth(f->depth);
   if (options.parameters_from_geometry) DeriveGeometryParameters(median_z, f->camera.fx, &options);
+  // Without a colour image the judge cannot tell a seam from an active
+  // stereo camera's noise in the depth, and the corners the along-view
+  // allowance adds propose readings of a seamless layer it cannot separate
+  // (eight generated depth-only sets: 7 wrong boxes more on stereo
+  // pallets, against 9 heap boxes more): the paper's sphere, unless the
+  // caller set the factor.
+  // A grey image that shows nothing (one level everywhere, or not
+  // registered) is no colour image: colour is evidence, never a switch.
+  if (!ColourShowsSomething(f->depth, options.refinement.colour_seams.min_contrast) &&
+      options.clubbing.meet_along_view_factor == ClubbingOptions{}.meet_along_view_factor) {
+    options.clubbing.meet_along_view_factor = 1.0;
+  }
   if (options.size_tolerance_m) ApplySizeTolerance(*options.size_tolerance_m, &options);
   if (options.edge_lattice_radius_px > 0.0) {
     const double radius_px =

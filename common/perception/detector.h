@@ -175,6 +175,13 @@ struct DetectorOptions {
   LayerPlaneOptions layer_plane;
   double floor_tolerance_m = 0.03;
   double floor_min_area_m2 = 0.25;
+  // ... and it is the floor only when at most this share of the frame lies
+  // beyond it (a lower layer's top or a pallet deck is the farthest plane
+  // found while the floor itself shows past it). 0.01 until session 28: a
+  // noisy stereo floor at 2.4 m (1 cm scatter) had 1.1 % of its own
+  // returns beyond it, no floor was found, and a face on bare floor was
+  // returned. Unitless, [0, 1].
+  double floor_max_beyond_share = 0.02;
   // With face proposals: a box whose top lies level (within this) with two
   // or more boxes found beside it (grasp faces parallel and touching, as
   // far as the box's largest face would reach: a layer around it) but

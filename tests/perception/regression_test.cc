@@ -1015,8 +1015,8 @@ TEST(RegressionTest, ABrickWhoseLongerReadingTheFloorRulesOutIsFound) {
 // 1-3 cm apart in depth (the camera's noise, along the line of sight),
 // beyond the 1 cm a corner's lines may be apart. Along the line of sight
 // they may now be three times that (ClubbingOptions::
-// meet_along_view_factor). Stereo brick s19 heap_001 of scripts/evaluate:
-// two bricks more, none wrong either way.
+// meet_along_view_factor; with a colour image). Stereo brick s19 heap_001
+// of scripts/evaluate: two bricks more, none wrong either way.
 TEST(RegressionTest, CornersOfStereoBricksMeetAcrossTheirDepthNoise) {
   const BoxDims brick{0.19, 0.09, 0.057};
   const absl::StatusOr<RenderedScene> frame =
@@ -1029,6 +1029,18 @@ TEST(RegressionTest, CornersOfStereoBricksMeetAcrossTheirDepthNoise) {
       [](bool on, DetectorOptions* o) { o->clubbing.meet_along_view_factor = on ? 3.0 : 1.0; });
   EXPECT_GT(det[1].corners.size(), det[0].corners.size());
   EXPECT_EQ(det[1].boxes.size(), det[0].boxes.size() + 2);
+  // Without its colour image the frame keeps the paper's sphere at the
+  // defaults (the judge cannot check the readings more corners propose).
+  PointCloud depth_only = cloud;
+  depth_only.rgb.clear();
+  DetectorOptions defaults;
+  defaults.box = brick;
+  const absl::StatusOr<Detection> plain = DetectBoxes(depth_only, defaults);
+  defaults.clubbing.meet_along_view_factor = 1.0;
+  const absl::StatusOr<Detection> sphere = DetectBoxes(depth_only, defaults);
+  ASSERT_TRUE(plain.ok() && sphere.ok());
+  EXPECT_EQ(plain->corners.size(), sphere->corners.size());
+  EXPECT_EQ(plain->boxes.size(), sphere->boxes.size());
 }
 
 // Was: an isolated stereo carton, refined from its four corners, was
