@@ -184,7 +184,8 @@ TEST(ClubSegmentsTest, ARectangleIsOneGroupOfFourWithFourCorners) {
   // leaves next to an already removed perpendicular side).
   std::vector<EdgeSegment> segments;
   for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector3d a = corners[k], b = corners[(k + 1) % 4];
+    const Eigen::Vector3d& a = corners[k];
+    const Eigen::Vector3d& b = corners[(k + 1) % 4];
     const Eigen::Vector3d d = (b - a).normalized();
     segments.push_back(MakeSegment(a + 0.015 * d, b - 0.015 * d));
   }
