@@ -304,6 +304,29 @@ bool CheckGaps(const DetectorOptions& options, std::vector<DetectedBox>* boxes,
   });
 }
 
+// Whether a box at `pose` was checked and kept in an earlier round of a
+// check that judges other readings of it (`cleared`): not judged again.
+bool WasCleared(const std::vector<Eigen::Isometry3d>& cleared, const Eigen::Isometry3d& pose) {
+  return std::any_of(cleared.begin(), cleared.end(), [&](const Eigen::Isometry3d& c) {
+    return (c.translation() - pose.translation()).norm() < 1e-4 &&
+           c.linear().isApprox(pose.linear());
+  });
+}
+
+// The end of such a check: the boxes `flagged` are taken out with
+// `reason`, the others `checked` are cleared. True when one was taken out.
+bool TakeOutFlagged(const std::vector<uint8_t>& checked, const std::vector<uint8_t>& flagged,
+                    const char* reason, std::vector<DetectedBox>* boxes,
+                    std::vector<KeptReading>* readings, std::vector<DeclinedCandidate>* declined,
+                    std::vector<Eigen::Isometry3d>* cleared) {
+  return TakeOut(boxes, readings, declined, [&](size_t i) -> std::string {
+    if (!checked[i]) return "";
+    if (flagged[i]) return reason;
+    cleared->push_back((*boxes)[i].camera_T_box);
+    return "";
+  });
+}
+
 // DetectorOptions::turned_check: a box whose face reads as well turned a
 // quarter at one of its measured corners is taken out. `cleared` holds the
 // boxes checked and kept before (the checks run in rounds), not judged
@@ -322,10 +345,7 @@ bool CheckTurnedReadings(const internal::HypothesisJudge& judge, const DetectorO
   for (int i = 0; i < n; ++i) {
     const std::array<SideKind, 4>& s = (*readings)[i].sides;
     if (std::all_of(s.begin(), s.end(), measured)) continue;
-    const Eigen::Isometry3d& T = (*boxes)[i].camera_T_box;
-    checked[i] = std::none_of(cleared->begin(), cleared->end(), [&](const Eigen::Isometry3d& c) {
-      return (c.translation() - T.translation()).norm() < 1e-4 && c.linear().isApprox(T.linear());
-    });
+    checked[i] = !WasCleared(*cleared, (*boxes)[i].camera_T_box);
   }
   internal::ParallelForChunks(n, 1, options.num_threads, [&](int, int i, int) {
     if (!checked[i]) return;
@@ -338,15 +358,10 @@ bool CheckTurnedReadings(const internal::HypothesisJudge& judge, const DetectorO
       }
     }
   });
-  return TakeOut(boxes, readings, declined, [&](size_t i) -> std::string {
-    if (!checked[i]) return "";
-    if (turned[i]) {
-      return "its face reads as well turned a quarter at one of its corners (a line in a face "
-             "taken for a seam?): declined as ambiguous";
-    }
-    cleared->push_back((*boxes)[i].camera_T_box);
-    return "";
-  });
+  return TakeOutFlagged(checked, turned,
+                        "its face reads as well turned a quarter at one of its corners (a line in "
+                        "a face taken for a seam?): declined as ambiguous",
+                        boxes, readings, declined, cleared);
 }
 
 // DetectorOptions::shifted_check: a box seamed on both sides of an axis,
@@ -369,10 +384,7 @@ bool CheckShiftedReadings(const internal::HypothesisJudge& judge, const Detector
     const bool seamed_a = s[0] == SideKind::kSeam && s[1] == SideKind::kSeam;
     const bool seamed_b = s[2] == SideKind::kSeam && s[3] == SideKind::kSeam;
     if ((!seamed_a && !seamed_b) || free_sides(s) >= 2) continue;
-    const Eigen::Isometry3d& T = (*boxes)[i].camera_T_box;
-    checked[i] = std::none_of(cleared->begin(), cleared->end(), [&](const Eigen::Isometry3d& c) {
-      return (c.translation() - T.translation()).norm() < 1e-4 && c.linear().isApprox(T.linear());
-    });
+    checked[i] = !WasCleared(*cleared, (*boxes)[i].camera_T_box);
   }
   internal::ParallelForChunks(n, 1, options.num_threads, [&](int, int i, int) {
     if (!checked[i]) return;
@@ -402,15 +414,10 @@ bool CheckShiftedReadings(const internal::HypothesisJudge& judge, const Detector
       }
     }
   });
-  return TakeOut(boxes, readings, declined, [&](size_t i) -> std::string {
-    if (!checked[i]) return "";
-    if (shifted[i]) {
-      return "its face shifted half its width across its two seams is a box ended by more free "
-             "sides (lines inside two faces taken for seams?): declined";
-    }
-    cleared->push_back((*boxes)[i].camera_T_box);
-    return "";
-  });
+  return TakeOutFlagged(checked, shifted,
+                        "its face shifted half its width across its two seams is a box ended by "
+                        "more free sides (lines inside two faces taken for seams?): declined",
+                        boxes, readings, declined, cleared);
 }
 
 // The strongest declined hypotheses: none that overlaps a returned box (a
