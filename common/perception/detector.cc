@@ -96,9 +96,10 @@ bool TakeOut(std::vector<DetectedBox>* boxes, std::vector<KeptReading>* readings
 // on one plane, together at least floor_min_area_m2 and three of the box's
 // largest faces, whose plane lies farthest from the camera along its
 // normal: the floor or table under a pallet, a heap or a bin), with no more
-// than floor_max_beyond_share of the frame beyond it (past floor_tolerance_m, or three times
-// the floor's own scatter scaled by z^2 to the point's depth). Found once a
-// frame, before any hypothesis is judged (HypothesisJudge::SetFloor).
+// than floor_max_beyond_share of the frame beyond it (past
+// floor_tolerance_m, or three times the floor's own scatter scaled by z^2
+// to the point's depth). Found once a frame, before any hypothesis is
+// judged (HypothesisJudge::SetFloor).
 struct FloorPlane {
   Eigen::Vector3d normal, centroid;  // the normal points at the camera
   double rms = 0.0;                  // its points' scatter about it, metres
@@ -407,7 +408,7 @@ bool CheckShiftedReadings(const internal::HypothesisJudge& judge, const Detector
         });
         if (on_kept) continue;
         const std::optional<internal::Candidate> c = judge.JudgeAlone(pose);
-        if (c && free_sides(c->refinement.sides) > free_sides(s)) {
+        if (c && c->refinement.free_sides > free_sides(s)) {
           shifted[i] = 1;
           return;
         }
@@ -668,14 +669,13 @@ absl::Status PrepareFrame(const PointCloud& input, const DetectorOptions& option
   f->depth = MakeDepthImage(*f->work, f->camera);
   const double median_z = MedianDepth(f->depth);
   if (options.parameters_from_geometry) DeriveGeometryParameters(median_z, f->camera.fx, &options);
-  // Without a colour image the judge cannot tell a seam from an active
-  // stereo camera's noise in the depth, and the corners the along-view
-  // allowance adds propose readings of a seamless layer it cannot separate
-  // (eight generated depth-only sets: 7 wrong boxes more on stereo
-  // pallets, against 9 heap boxes more): the paper's sphere, unless the
-  // caller set the factor.
-  // A grey image that shows nothing (one level everywhere, or not
-  // registered) is no colour image: colour is evidence, never a switch.
+  // Without a colour image that shows something (a grey image of one
+  // level is none: colour is evidence, never a switch) the judge cannot
+  // tell a seam from an active stereo camera's noise in the depth, and the
+  // corners the along-view allowance adds propose readings of a seamless
+  // layer it cannot separate (eight generated depth-only sets: 7 wrong
+  // boxes more on stereo pallets, against 9 heap boxes more): the paper's
+  // sphere, unless the caller set the factor.
   if (!ColourShowsSomething(f->depth, options.refinement.colour_seams.min_contrast) &&
       options.clubbing.meet_along_view_factor == ClubbingOptions{}.meet_along_view_factor) {
     options.clubbing.meet_along_view_factor = 1.0;

@@ -49,10 +49,12 @@ int WrongBoxes(const Detection& det, const RenderedScene& r) {
 }
 
 // The frame's detections with a rule off and on ({off, on}; `set_rule`
-// sets it in the options), each checked for wrong boxes.
+// sets it in the options), each checked for wrong boxes: none with the rule
+// on, and none with it off too unless `wrong_without` (a rule that takes a
+// wrong box out: then at least one).
 std::array<Detection, 2> DetectedWithRuleOffAndOn(
     const PointCloud& cloud, const RenderedScene& r, const BoxDims& dims,
-    const std::function<void(bool on, DetectorOptions*)>& set_rule) {
+    const std::function<void(bool on, DetectorOptions*)>& set_rule, bool wrong_without = false) {
   std::array<Detection, 2> out;
   for (const bool on : {false, true}) {
     DetectorOptions options;
@@ -61,7 +63,11 @@ std::array<Detection, 2> DetectedWithRuleOffAndOn(
     absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
     EXPECT_TRUE(det.ok()) << det.status();
     if (!det.ok()) continue;
-    EXPECT_EQ(WrongBoxes(*det, r), 0) << (on ? "rule on" : "rule off");
+    if (on || !wrong_without) {
+      EXPECT_EQ(WrongBoxes(*det, r), 0) << (on ? "rule on" : "rule off");
+    } else {
+      EXPECT_GE(WrongBoxes(*det, r), 1) << "without the rule the wrong box is returned";
+    }
     out[on] = *std::move(det);
   }
   return out;
@@ -1076,20 +1082,12 @@ TEST(RegressionTest, AFaceShortOfTheBoxBothWaysIsNotReturned) {
       SensorFrame(SensorKind::kStereo, true, "touching1", carton_s, 2, 55002);
   ASSERT_TRUE(frame.ok()) << frame.status();
   const RenderedScene& r = *frame;
-  const PointCloud cloud = RoundedToMillimetres(r);
-  for (const double short_both : {0.012, 0.0}) {
-    DetectorOptions options;
-    options.box = carton_s;
-    options.acceptance.max_short_both_axes_m = short_both;
-    const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
-    ASSERT_TRUE(det.ok()) << det.status();
-    EXPECT_GE(det->boxes.size(), 12u) << "rule at " << short_both;
-    if (short_both > 0.0) {
-      EXPECT_EQ(WrongBoxes(*det, r), 0);
-    } else {
-      EXPECT_GE(WrongBoxes(*det, r), 1) << "without the rule the smaller box is a carton on end";
-    }
-  }
+  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
+      RoundedToMillimetres(r), r, carton_s,
+      [](bool on, DetectorOptions* o) { o->acceptance.max_short_both_axes_m = on ? 0.012 : 0.0; },
+      /*wrong_without=*/true);
+  EXPECT_GE(det[0].boxes.size(), 12u);
+  EXPECT_GE(det[1].boxes.size(), 12u);
 }
 
 // Was: on a stereo pallet of carton_flat (0.30 x 0.20 x 0.10 m) cut by the
@@ -1107,24 +1105,18 @@ TEST(RegressionTest, ABoxOnItsSideFlushAgainstALevelBoxIsTakenOut) {
       SensorFrame(SensorKind::kStereo, true, "touching1", carton_flat, 2, 65002);
   ASSERT_TRUE(frame.ok()) << frame.status();
   const RenderedScene& r = *frame;
-  const PointCloud cloud = RoundedToMillimetres(r);
-  for (const bool flush : {true, false}) {
-    DetectorOptions options;
-    options.box = carton_flat;
-    options.flush_neighbour_is_layer = flush;
-    // As the rule was made (since then the shifted check and a lower
-    // side_ends_share change which reading of the layer is kept first).
-    options.refinement.side_ends_share = 0.67;
-    options.shifted_check = false;
-    const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
-    ASSERT_TRUE(det.ok()) << det.status();
-    EXPECT_GE(det->boxes.size(), 10u) << "rule " << flush;
-    if (flush) {
-      EXPECT_EQ(WrongBoxes(*det, r), 0);
-    } else {
-      EXPECT_GE(WrongBoxes(*det, r), 1) << "without the rule the carton on its side is returned";
-    }
-  }
+  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
+      RoundedToMillimetres(r), r, carton_flat,
+      [](bool on, DetectorOptions* o) {
+        o->flush_neighbour_is_layer = on;
+        // As the rule was made (since then the shifted check and a lower
+        // side_ends_share change which reading of the layer is kept first).
+        o->refinement.side_ends_share = 0.67;
+        o->shifted_check = false;
+      },
+      /*wrong_without=*/true);
+  EXPECT_GE(det[0].boxes.size(), 10u);
+  EXPECT_GE(det[1].boxes.size(), 10u);
 }
 
 // Was: on the same stereo carton_flat pallet, with a side read free where
@@ -1141,23 +1133,14 @@ TEST(RegressionTest, ACartonStraddlingTwoOnTheirTapeEdgesIsTakenOut) {
       SensorFrame(SensorKind::kStereo, true, "touching1", carton_flat, 2, 65002);
   ASSERT_TRUE(frame.ok()) << frame.status();
   const RenderedScene& r = *frame;
-  const PointCloud cloud = RoundedToMillimetres(r);
-  std::array<size_t, 2> found{};
-  for (const bool check : {true, false}) {
-    DetectorOptions options;
-    options.box = carton_flat;
-    options.refinement.side_ends_share = 0.55;
-    options.shifted_check = check;
-    const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
-    ASSERT_TRUE(det.ok()) << det.status();
-    found[check] = det->boxes.size();
-    if (check) {
-      EXPECT_EQ(WrongBoxes(*det, r), 0);
-    } else {
-      EXPECT_GE(WrongBoxes(*det, r), 1) << "without the check the straddling carton is returned";
-    }
-  }
-  EXPECT_GT(found[1], found[0]);
+  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
+      RoundedToMillimetres(r), r, carton_flat,
+      [](bool on, DetectorOptions* o) {
+        o->shifted_check = on;
+        o->refinement.side_ends_share = 0.55;
+      },
+      /*wrong_without=*/true);
+  EXPECT_GT(det[1].boxes.size(), det[0].boxes.size());
 }
 
 }  // namespace
