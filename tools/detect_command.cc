@@ -138,7 +138,9 @@ constexpr char kHelp[] =
     "  --rim_sides BOOL     a side where the face runs on but ends within 2 cm is free\n"
     "                       there, when it is the face's only side in doubt (true)\n"
     "  --side_ends SHARE    a side where the face ends within 5 mm along SHARE of it\n"
-    "                       is free, whatever lies flat past the rest (0.55; 0: off)\n"
+    "                       is free, whatever lies flat past the rest (0.35; 0: off)\n"
+    "  --side_ends_alone SHARE ... along less than SHARE of it only when two of the\n"
+    "                       face's three other sides are measured (0.55)\n"
     "  --anchored_faces BOOL a planar patch that does not tile (an L of box tops, a\n"
     "                       layer cut by the border) proposes a face in each of its\n"
     "                       corners (false)\n"
@@ -225,6 +227,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("merged_pieces", &options.faces.propose_merged_pieces),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
         args.SetDouble("side_ends", &options.refinement.side_ends_share),
+        args.SetDouble("side_ends_alone", &options.refinement.side_ends_alone_share),
         args.SetDouble("end_on_flat", &options.refinement.end_on_flat_shift_m),
         args.SetDouble("slat_gap", &options.refinement.slat_gap_max_m),
         args.SetDouble("extra_step", &options.refinement.extra_step_corner_move_m),
@@ -357,6 +360,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "merged_pieces",
                                                        "rim_sides",
                                                        "side_ends",
+                                                       "side_ends_alone",
                                                        "end_on_flat",
                                                        "slat_gap",
                                                        "extra_step",

@@ -250,6 +250,9 @@ struct SideMeasure {
   // kUnknown only: enough of the pixels just inside the side see behind the
   // plane (RefinementOptions::seen_through_share): the face ends before it.
   bool seen_through = false;
+  // kFree only: found free by RefinementOptions::side_ends_share along
+  // less than side_ends_alone_share of the side (PartlyEndedNeedsTwoMore).
+  bool partly_ended = false;
   // kContinues only: where the face's points end within the band.
   bool rim = false;
   double rim_position = 0.0, rim_slope = 0.0;
@@ -686,6 +689,7 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
         best.begin(), best.end(), [&](double b) { return b > -1.0 && b <= half + 0.005; }));
     if (ends >= o.side_ends_share * nbins && measure_end(&m, half + 0.005)) {
       m.kind = SideKind::kFree;
+      m.partly_ended = ends < o.side_ends_alone_share * nbins;
       return m;
     }
   }
@@ -721,6 +725,23 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
   if (!measure_end(&m)) return m;
   m.kind = SideKind::kFree;
   return m;
+}
+
+// A side free where the face ends along only part of it (SideMeasure::
+// partly_ended) stays free only when at least two of the face's three other
+// sides are measured; otherwise the face runs on there: two bricks lying in
+// an L with level tops hold a reading across both, turned a quarter, that
+// ends along part of one side and has two sides hidden.
+void PartlyEndedNeedsTwoMore(const std::array<SideMeasure*, 4>& sides) {
+  for (int i = 0; i < 4; ++i) {
+    if (sides[i]->kind != SideKind::kFree || !sides[i]->partly_ended) continue;
+    int unmeasured = 0;
+    for (int j = 0; j < 4; ++j) unmeasured += j != i && !sides[j]->measured();
+    if (unmeasured > 1) {
+      sides[i]->kind = SideKind::kContinues;
+      sides[i]->partly_ended = false;
+    }
+  }
 }
 
 // No side of the face hidden under something or cut by the image's edge.
@@ -1055,6 +1076,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.max_tile_march_m", max_tile_march_m, 0.0, 100.0),
            CheckRange("refinement.rim_extent_tolerance_m", rim_extent_tolerance_m, 0.0, 0.1),
            CheckRange("refinement.side_ends_share", side_ends_share, 0.0, 1.0),
+           CheckRange("refinement.side_ends_alone_share", side_ends_alone_share, 0.0, 1.0),
            CheckRange("refinement.iterations", iterations, 0, 20),
            CheckRange("refinement.end_on_flat_shift_m", end_on_flat_shift_m, 0.0, 0.05),
            CheckRange("refinement.extra_step_corner_move_m", extra_step_corner_move_m, 0.0, 0.05),
@@ -1127,6 +1149,7 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
                           options.plane_tolerance_m);
     });
   }
+  PartlyEndedNeedsTwoMore(sides);
   result.sides = {pa.kind, ma.kind, pb.kind, mb.kind};
   result.seen_through = {pa.seen_through, ma.seen_through, pb.seen_through, mb.seen_through};
   result.free_sides = 0;

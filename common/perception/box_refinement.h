@@ -101,9 +101,17 @@ struct RefinementOptions {
   // 78 evaluation sets, and no wrong one once DetectorOptions::
   // shifted_check took out a carton straddling two and the floor of a
   // noisy stereo frame was found (floor_max_beyond_share): a face on that
-  // bare floor ended along 0.55 of its sides. 0: off (the side runs on, or
-  // is a seam). Unitless.
-  double side_ends_share = 0.55;
+  // bare floor ended along 0.55 of its sides. 0.35 since session 29, with
+  // side_ends_alone_share: 13 more boxes on 46 sets (two cartons side by
+  // side, their level tops offset along the side they share), no wrong one.
+  // 0: off (the side runs on, or is a seam). Unitless.
+  double side_ends_share = 0.35;
+  // A side so found free along less than this share of it is free only
+  // when at least two of the face's three other sides are measured (free
+  // or a seam): a face across two bricks lying in an L with level tops,
+  // turned a quarter, ends along part of a side as well, with two sides
+  // hidden (0.25 without this rule: a wrong brick). Unitless, [0, 1].
+  double side_ends_alone_share = 0.55;
   // A seam found along a side whose stretch (its length less a band at
   // each end) is at least this long turns the face as a free side does:
   // by where each half of the side has the seam. Seams along shorter

@@ -370,6 +370,9 @@ TEST(RefinementOptionsTest, ValidateNamesTheNewFields) {
   o.seen_through_share = 0.4;
   o.side_ends_share = -0.1;
   EXPECT_NE(o.Validate().message().find("side_ends_share"), std::string::npos);
+  o.side_ends_share = 0.55;
+  o.side_ends_alone_share = 1.5;
+  EXPECT_NE(o.Validate().message().find("side_ends_alone_share"), std::string::npos);
 }
 
 // A carton of the layer under another that stands on it right at the
@@ -545,6 +548,54 @@ TEST(RefineOnGraspFaceTest, ASideANeighbourMeetsAtOneCornerIsFree) {
                               RefinementOptions{}, &pose)
                 .sides[0],
             SideKind::kSeam);
+}
+
+// A carton whose level neighbour meets its +x end along 10 of its 20 cm:
+// the face ends at that side along half of the side's stretch. By default
+// (side_ends_share 0.35) the side is free, as are its three others; with
+// the share of session 28 (0.55) it is not. With taller cartons standing
+// against its -x end and its -y side (two sides hidden) it runs on
+// (RefinementOptions::side_ends_alone_share: a reading across two bricks
+// lying in an L with level tops ends along part of a side too), with one
+// of them it is free, and so it is with both when the share it ends along
+// passes side_ends_alone_share.
+TEST(RefineOnGraspFaceTest, ASideEndingAlongHalfIsFreeWithTwoOtherSidesMeasured) {
+  const SceneBox neighbour = Flat(kCartonS, kCartonS.l, 0.10);
+  const FlatScene s = RenderFlat({Flat(kCartonS, 0.0, 0.0), neighbour});
+  const GroundTruthBox& gt = s.rendered.boxes[0];
+  Eigen::Isometry3d pose = Moved(gt.camera_T_box, 0.004, -0.003, 1.0);
+  const RefinementResult r =
+      RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), RefinementOptions{}, &pose);
+  ASSERT_TRUE(r.ok);
+  for (SideKind k : r.sides) EXPECT_EQ(k, SideKind::kFree);
+  EXPECT_LT(ComparePoses(pose, gt.camera_T_box, kCartonS).translation_m, 0.003);
+  RefinementOptions session28;
+  session28.side_ends_share = 0.55;
+  pose = Moved(gt.camera_T_box, 0.004, -0.003, 1.0);
+  EXPECT_NE(RefineOnGraspFace(s.depth, kCartonS, TopFace(gt), session28, &pose).sides[0],
+            SideKind::kFree);
+
+  const BoxDims taller{0.30, 0.20, 0.30};
+  const SceneBox past_end = Flat(taller, -kCartonS.l - 0.003, 0.0);
+  const SceneBox past_side = Flat(taller, 0.0, -kCartonS.b - 0.003);
+  auto plus_a = [&](const std::vector<SceneBox>& boxes, const RefinementOptions& o) {
+    const FlatScene scene = RenderFlat(boxes);
+    const GroundTruthBox& box = scene.rendered.boxes[0];
+    Eigen::Isometry3d p = Moved(box.camera_T_box, 0.004, -0.003, 1.0);
+    return RefineOnGraspFace(scene.depth, kCartonS, TopFace(box), o, &p);
+  };
+  const RefinementResult two_hidden =
+      plus_a({Flat(kCartonS, 0.0, 0.0), neighbour, past_end, past_side}, RefinementOptions{});
+  EXPECT_EQ(two_hidden.sides[1], SideKind::kOccluded);
+  EXPECT_EQ(two_hidden.sides[3], SideKind::kOccluded);
+  EXPECT_EQ(two_hidden.sides[0], SideKind::kContinues);
+  EXPECT_EQ(plus_a({Flat(kCartonS, 0.0, 0.0), neighbour, past_end}, RefinementOptions{}).sides[0],
+            SideKind::kFree)
+      << "one other side hidden";
+  RefinementOptions alone;
+  alone.side_ends_alone_share = 0.4;
+  EXPECT_EQ(plus_a({Flat(kCartonS, 0.0, 0.0), neighbour, past_end, past_side}, alone).sides[0],
+            SideKind::kFree);
 }
 
 }  // namespace
