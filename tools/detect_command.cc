@@ -141,6 +141,8 @@ constexpr char kHelp[] =
     "                       is free, whatever lies flat past the rest (0.35; 0: off)\n"
     "  --side_ends_alone SHARE ... along less than SHARE of it only when two of the\n"
     "                       face's three other sides are measured (0.55)\n"
+    "  --seam_depth_rms K   a groove along a side is a seam only when deeper than K\n"
+    "                       times the face's own RMS about its plane (1; 0: 1.5 mm alone)\n"
     "  --anchored_faces BOOL a planar patch that does not tile (an L of box tops, a\n"
     "                       layer cut by the border) proposes a face in each of its\n"
     "                       corners (false)\n"
@@ -228,6 +230,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
         args.SetDouble("side_ends", &options.refinement.side_ends_share),
         args.SetDouble("side_ends_alone", &options.refinement.side_ends_alone_share),
+        args.SetDouble("seam_depth_rms", &options.refinement.seam_depth_per_rms),
         args.SetDouble("end_on_flat", &options.refinement.end_on_flat_shift_m),
         args.SetDouble("slat_gap", &options.refinement.slat_gap_max_m),
         args.SetDouble("extra_step", &options.refinement.extra_step_corner_move_m),
@@ -361,6 +364,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "rim_sides",
                                                        "side_ends",
                                                        "side_ends_alone",
+                                                       "seam_depth_rms",
                                                        "end_on_flat",
                                                        "slat_gap",
                                                        "extra_step",

@@ -64,6 +64,10 @@ struct FacePoints {
   // The points on the plane >= 1 cm inside every side, as their count and
   // the sums of their coordinates and products (all the plane fit needs).
   int interior = 0;
+  // How deep a groove along a side must be to make a seam
+  // (RefinementOptions::min_seam_depth_m, seam_depth_per_rms), set once the
+  // plane is fitted.
+  double seam_depth_m = 0.0;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
   std::array<std::vector<FacePoint>, 4> on_plane, front, grid;  // +a, -a, +b, -b bands
@@ -308,8 +312,9 @@ void BucketSort(std::vector<T>* values, double lo, double hi, Key key) {
 class SeamScan {
  public:
   SeamScan(const std::vector<FacePoint>& pts, const std::vector<FacePoint>& grid, bool along_a,
-           double sign, double half, double half_other, double pixel_m, const RefinementOptions& o)
-      : o_(o) {
+           double sign, double half, double half_other, double pixel_m, double seam_depth_m,
+           const RefinementOptions& o)
+      : o_(o), depth_(seam_depth_m) {
     const double reach = o.side_band_m;
     auto band = [&](const FacePoint& p, double* across, double* along) {
       *across = sign * (along_a ? p.a : p.b) - half;
@@ -340,7 +345,7 @@ class SeamScan {
 
   // The points of this side with along in [lo, hi).
   SeamScan Stretch(double lo, double hi) const {
-    SeamScan part(o_);
+    SeamScan part(o_, depth_);
     part.rows_.reserve(rows_.size());
     part.expected_.reserve(expected_.size());
     for (const Row& r : rows_) {
@@ -381,10 +386,10 @@ class SeamScan {
     // Strength: how far past its threshold each test is; a weaker dip in
     // density counts when a groove half as deep as the threshold backs it.
     const double density_strength = (o_.max_seam_density - density_ratio) / o_.max_seam_density;
-    const double groove_strength = (groove - o_.min_seam_depth_m) / o_.min_seam_depth_m;
+    const double groove_strength = (groove - depth_) / depth_;
     const double joint_strength =
         std::min((o_.weak_seam_density - density_ratio) / o_.weak_seam_density,
-                 (groove - 0.5 * o_.min_seam_depth_m) / o_.min_seam_depth_m);
+                 (groove - 0.5 * depth_) / depth_);
     // A sparse line of missing returns (a gap finer than a pixel): the
     // missing share above the flanks', and how unlikely that excess is at
     // the flanks' rate (a floor of one in 200 keeps a spotless face from
@@ -411,7 +416,7 @@ class SeamScan {
       return across != r.across ? across < r.across : height < r.height;
     }
   };
-  explicit SeamScan(const RefinementOptions& o) : o_(o) {}
+  SeamScan(const RefinementOptions& o, double seam_depth_m) : o_(o), depth_(seam_depth_m) {}
 
   // Sorted positions x with prefix sums of 1, x, y and x y: the count and
   // y-sum of the points in a window [lo, hi) when each point is spread
@@ -507,6 +512,7 @@ class SeamScan {
   }
 
   const RefinementOptions& o_;
+  double depth_;  // least groove depth for a seam (FacePoints::seam_depth_m)
   std::vector<Row> rows_;
   struct Pixel {
     double across, along, hit;  // hit: 1 with a return on the plane, else 0
@@ -530,10 +536,10 @@ class SeamScan {
 // Returns the seam's position (outward coordinate) or nothing.
 std::optional<double> FindSeam(const std::vector<FacePoint>& pts,
                                const std::vector<FacePoint>& grid, bool along_a, double sign,
-                               double half, double half_other, double pixel_m,
+                               double half, double half_other, double pixel_m, double seam_depth_m,
                                const RefinementOptions& o, std::optional<double>* slope) {
   constexpr double kAll = std::numeric_limits<double>::infinity();
-  const SeamScan whole(pts, grid, along_a, sign, half, half_other, pixel_m, o);
+  const SeamScan whole(pts, grid, along_a, sign, half, half_other, pixel_m, seam_depth_m, o);
   if (whole.points() < 50 || whole.expected() < 50) return std::nullopt;
   std::optional<double> best;
   double best_strength = 0.0;
@@ -710,8 +716,8 @@ SideMeasure MeasureSide(const FacePoints& face, bool along_a, double sign, doubl
         m.rim = true;
       }
     };
-    if (std::optional<double> seam =
-            FindSeam(pts, grid, along_a, sign, half, half_other, pixel_m, o, &m.seam_slope)) {
+    if (std::optional<double> seam = FindSeam(pts, grid, along_a, sign, half, half_other, pixel_m,
+                                              face.seam_depth_m, o, &m.seam_slope)) {
       m.kind = SideKind::kSeam;
       m.position = *seam;
       m.outward_seam = *seam - half > o.seam_search_m - 0.0015;
@@ -1077,6 +1083,7 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.rim_extent_tolerance_m", rim_extent_tolerance_m, 0.0, 0.1),
            CheckRange("refinement.side_ends_share", side_ends_share, 0.0, 1.0),
            CheckRange("refinement.side_ends_alone_share", side_ends_alone_share, 0.0, 1.0),
+           CheckRange("refinement.seam_depth_per_rms", seam_depth_per_rms, 0.0, 10.0),
            CheckRange("refinement.iterations", iterations, 0, 20),
            CheckRange("refinement.end_on_flat_shift_m", end_on_flat_shift_m, 0.0, 0.05),
            CheckRange("refinement.extra_step_corner_move_m", extra_step_corner_move_m, 0.0, 0.05),
@@ -1117,6 +1124,8 @@ bool RefineStep(const DepthImage& depth, const BoxDims& dims, BoxFace grasp_face
   if (normal_local.z() < 0.0) normal_local = -normal_local;
   result.plane_rms_m = std::sqrt(std::max(0.0, eig.eigenvalues()(0)) / n);
   result.face_points = n;
+  face.seam_depth_m =
+      std::max(options.min_seam_depth_m, options.seam_depth_per_rms * result.plane_rms_m);
 
   // Sides: +a, -a, +b, -b.
   SideMeasure pa = MeasureSide(face, true, 1.0, f.half_a, f.half_b, pixel_m, options);

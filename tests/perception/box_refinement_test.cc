@@ -373,6 +373,9 @@ TEST(RefinementOptionsTest, ValidateNamesTheNewFields) {
   o.side_ends_share = 0.55;
   o.side_ends_alone_share = 1.5;
   EXPECT_NE(o.Validate().message().find("side_ends_alone_share"), std::string::npos);
+  o.side_ends_alone_share = 0.55;
+  o.seam_depth_per_rms = -1.0;
+  EXPECT_NE(o.Validate().message().find("seam_depth_per_rms"), std::string::npos);
 }
 
 // A carton of the layer under another that stands on it right at the
