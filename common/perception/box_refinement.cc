@@ -386,10 +386,13 @@ class SeamScan {
     // Strength: how far past its threshold each test is; a weaker dip in
     // density counts when a groove half as deep as the threshold backs it.
     const double density_strength = (o_.max_seam_density - density_ratio) / o_.max_seam_density;
+    // A groove alone must be deeper than the face is rough (depth_); one
+    // that comes with a dip in density (missing returns, which a Kinect's
+    // disparity stripes do not make) needs only half of min_seam_depth_m.
     const double groove_strength = (groove - depth_) / depth_;
     const double joint_strength =
         std::min((o_.weak_seam_density - density_ratio) / o_.weak_seam_density,
-                 (groove - 0.5 * depth_) / depth_);
+                 (groove - 0.5 * o_.min_seam_depth_m) / o_.min_seam_depth_m);
     // A sparse line of missing returns (a gap finer than a pixel): the
     // missing share above the flanks', and how unlikely that excess is at
     // the flanks' rate (a floor of one in 200 keeps a spotless face from

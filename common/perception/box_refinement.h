@@ -36,13 +36,13 @@ struct RefinementOptions {
   // A density dip down to this share also makes a seam when a groove of
   // half min_seam_depth_m comes with it.
   double weak_seam_density = 0.85;
-  // ... and the groove must be deeper than this many times the face's own
-  // roughness (the RMS of its interior about the fitted plane) where that
-  // is more than min_seam_depth_m: a Kinect's disparity steps lay stripes a
-  // step high (5-6 mm at 1.4 m) across a flat deck board, and one running
-  // along a side read as a 1.6 mm groove (a brick-sized piece of a board
-  // beside a layer, returned as a brick). 0: min_seam_depth_m alone.
-  // Unitless, [0, 10].
+  // A groove alone (no dip in density with it) must also be deeper than
+  // this many times the face's own roughness (the RMS of its interior about
+  // the fitted plane): a Kinect's disparity steps lay stripes a step high
+  // (5-6 mm at 1.4 m) across a flat deck board, and one running along a
+  // side read as a 1.6 mm groove (a brick-sized piece of a board beside a
+  // layer, returned as a brick). 0: min_seam_depth_m alone. Unitless,
+  // [0, 10].
   double seam_depth_per_rms = 1.0;
   // A gap finer than a pixel leaves a sparse line of missing returns rather
   // than a gap in the points: it is a seam when the share of pixels along
