@@ -170,7 +170,7 @@ class OrganizedScorer {
   // points would pass t_h; the median offset is ~0 at a true edge.
   NeighbourSum Neighbours(int u, int v, const Eigen::Vector3f& p, float radius_px) const {
     // The neighbours as structure of arrays (per thread, sized once).
-    thread_local std::vector<float> fx, fy, fz, dz;
+    thread_local std::vector<float> fx, fy, fz, dz, scratch;
     const float reach2 = 2.25f * radius2_;  // 1.5 r_s: room for p's own noise
     // CutByBorder() has kept the whole disc inside the image.
     // Read in place (Eigen::Vector3f is three packed floats): a copy as
@@ -185,7 +185,7 @@ class OrganizedScorer {
     const std::vector<int>& offsets = offsets_[bucket];
     // Room for a whole block of four past the last neighbour.
     if (fx.size() < offsets.size() + 4) {
-      for (std::vector<float>* a : {&fx, &fy, &fz, &dz}) a->resize(offsets.size() + 4);
+      for (std::vector<float>* a : {&fx, &fy, &fz, &dz, &scratch}) a->resize(offsets.size() + 4);
     }
     // Without branches: every neighbour is written, and kept (m advances)
     // when it is within reach; a no-return (NaN) compares false.
@@ -203,7 +203,7 @@ class OrganizedScorer {
     if (options_.denoise && m >= 3) {
       for (size_t k = 0; k < m; ++k) dz[k] = fz[k] - pz;
       const float median =
-          internal::SelectKth(dz.data(), static_cast<int>(m), static_cast<int>(m / 2));
+          internal::SelectKth(dz.data(), static_cast<int>(m), static_cast<int>(m / 2), scratch.data());
       centre = p * ((pz + median) / pz);
     }
     return UnitVectorSum(fx.data(), fy.data(), fz.data(), m, centre);

@@ -313,12 +313,10 @@ TEST(SelectKthTest, MatchesNthElement) {
       std::uniform_int_distribution<int> level(0, levels - 1);
       for (float& x : a) x = 0.001f * static_cast<float>(level(rng)) - 0.2f;
       for (const int k : {0, n / 2, n - 1}) {
-        std::vector<float> b = a, c = a;
+        std::vector<float> b = a, c = a, scratch(n);
         std::nth_element(b.begin(), b.begin() + k, b.end());
-        ASSERT_EQ(internal::SelectKth(c.data(), n, k), b[k]) << "n " << n << " k " << k;
-        std::sort(c.begin(), c.end());
-        std::sort(b.begin(), b.end());
-        ASSERT_EQ(b, c);  // a permutation of the input
+        ASSERT_EQ(internal::SelectKth(c.data(), n, k, scratch.data()), b[k])
+            << "n " << n << " k " << k;
       }
     }
   }
