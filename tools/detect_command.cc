@@ -137,6 +137,8 @@ constexpr char kHelp[] =
     "                       face's corners by more than M (0.003; 0: never)\n"
     "  --rim_sides BOOL     a side where the face runs on but ends within 2 cm is free\n"
     "                       there, when it is the face's only side in doubt (true)\n"
+    "  --rim_occluded BOOL  ... also when its opposite side is occluded (a box standing\n"
+    "                       in front there) and its other two sides are measured (true)\n"
     "  --side_ends SHARE    a side where the face ends within 5 mm along SHARE of it\n"
     "                       is free, whatever lies flat past the rest (0.35; 0: off)\n"
     "  --side_ends_alone SHARE ... along less than SHARE of it only when two of the\n"
@@ -228,6 +230,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("seam_split", &options.faces.seam_split.enabled),
         args.SetBool("merged_pieces", &options.faces.propose_merged_pieces),
         args.SetBool("rim_sides", &options.refinement.rim_ends_side),
+        args.SetBool("rim_occluded", &options.refinement.rim_beside_occluded),
         args.SetDouble("side_ends", &options.refinement.side_ends_share),
         args.SetDouble("side_ends_alone", &options.refinement.side_ends_alone_share),
         args.SetDouble("seam_depth_rms", &options.refinement.seam_depth_per_rms),
@@ -362,6 +365,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "seam_split",
                                                        "merged_pieces",
                                                        "rim_sides",
+                                                       "rim_occluded",
                                                        "side_ends",
                                                        "side_ends_alone",
                                                        "seam_depth_rms",

@@ -823,13 +823,25 @@ double FurtherShare(const DepthImage& depth, const FaceFrame& f, int side, int i
 // runs on past that side by a centimetre or so and then ends: the side is
 // free where the face ends, when that is the only side in doubt: its
 // opposite side free, and every side of the face measured (a side hidden or
-// cut would leave the face's true size open). `further(i)` is side i's
+// cut would leave the face's true size open), or (rim_beside_occluded) its
+// opposite side occluded and the other axis measured on both sides: the
+// face's size across is then the box's, from the rim. `further(i)` is side i's
 // FurtherShare (read only for the few faces that get that far).
 template <typename Further>
 void RimAsFree(const std::array<SideMeasure*, 4>& sides, double half_a, double half_b,
                const RefinementOptions& o, const Further& further) {
-  if (!EverySideSeen(sides)) return;
-  auto candidate = [&](int i) { return sides[i]->kind == SideKind::kContinues && sides[i]->rim; };
+  // With rim_beside_occluded, one side may be occluded: the rim's opposite.
+  int occluded = -1;
+  for (int i = 0; i < 4; ++i) {
+    if (sides[i]->kind == SideKind::kUnknown) return;
+    if (sides[i]->kind != SideKind::kOccluded) continue;
+    if (occluded >= 0 || !o.rim_beside_occluded) return;
+    occluded = i;
+  }
+  auto candidate = [&](int i) {
+    return sides[i]->kind == SideKind::kContinues && sides[i]->rim &&
+           (occluded < 0 || occluded == (i ^ 1));
+  };
   // The face so measured is the box's size on both axes: across the rim
   // from rim_extent_tolerance_m short to twice it long (the rim adds to
   // it), along it within the tolerance when both its sides are free (a face
@@ -841,6 +853,13 @@ void RimAsFree(const std::array<SideMeasure*, 4>& sides, double half_a, double h
     const double half = rim < 2 ? half_a : half_b, other_half = rim < 2 ? half_b : half_a;
     const SideMeasure& o1 = *sides[rim < 2 ? 2 : 0];
     const SideMeasure& o2 = *sides[rim < 2 ? 3 : 1];
+    if (opposite.kind == SideKind::kOccluded) {
+      // The face may go on under what stands there: its extent across is
+      // open, so the other axis must be pinned on both sides.
+      if (!o1.measured() || !o2.measured()) return false;
+      return !(o1.kind == SideKind::kFree && o2.kind == SideKind::kFree &&
+               std::abs(o1.position + o2.position - 2.0 * other_half) > o.rim_extent_tolerance_m);
+    }
     const double over = m.rim_position + opposite.position - 2.0 * half;
     return opposite.kind == SideKind::kFree && over >= -o.rim_extent_tolerance_m &&
            over <= 2.0 * o.rim_extent_tolerance_m &&

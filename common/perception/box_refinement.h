@@ -98,6 +98,14 @@ struct RefinementOptions {
   // from this short to twice this long, along it within this (where both
   // its sides are free). Metres.
   double rim_extent_tolerance_m = 0.015;
+  // ... and also when its opposite side is occluded instead of free (a box
+  // standing in front there, under which the face may go on), the face's
+  // other two sides measured (free or a seam), and no side hidden or cut:
+  // in a heap seen by an active stereo camera the fattened edge of a top
+  // whose other long side a box in front hides left the top unmeasured
+  // across. The face's extent across the rim is then the box's, from the
+  // rim.
+  bool rim_beside_occluded = true;
   // A side past which the face's plane goes on along only part of it is
   // free when, read in 1 cm stretches, the face ends within 5 mm past the
   // side along at least this share of it: what lies flat past the rest is

@@ -437,6 +437,49 @@ TEST(RefineOnGraspFaceTest, AFaceARimTooLongEndsWhereItsPointsEnd) {
   EXPECT_EQ(r_off.sides[0], SideKind::kContinues);
 }
 
+// The same rim with a taller box standing against the opposite side, which
+// hides it (occluded: the face may go on under it). With the other two
+// sides free the rim still ends the face, and the box is placed from it
+// (RefinementOptions::rim_beside_occluded): an active stereo camera's
+// fattened top in a heap, its other long side behind a box in front.
+TEST(RefineOnGraspFaceTest, ARimEndsTheFaceWhenItsOppositeSideIsOccluded) {
+  const BoxDims bulging{kCartonS.l, kCartonS.b + 0.012, kCartonS.h};
+  const BoxDims tall{0.30, 0.20, 0.35};
+  const SceneBox carton = Flat(bulging, 0.0, 0.0);
+  const SceneBox in_front = Flat(tall, 0.0, -(bulging.b / 2.0 + tall.b / 2.0 + 0.004));
+  Scene scene;
+  scene.camera = CameraIntrinsics{};
+  scene.world_T_camera = LookAtCamera(Eigen::Vector3d(0.0, 0.02, bulging.h), 1.3, -12.0, 8.0, 0.0);
+  scene.boxes = {carton, in_front};
+  NoiseOptions exact;
+  exact.enabled = false;
+  const RenderedScene rendered = Render(scene, exact);
+  const DepthImage depth = MakeDepthImage(rendered.cloud, rendered.camera);
+  const GroundTruthBox& gt = rendered.boxes[0];
+  // The reading flush with the occluded -y side: +y runs on by 12 mm.
+  const Eigen::Isometry3d flush = Moved(gt.camera_T_box, 0.0, -0.006, 0.0);
+  Eigen::Isometry3d pose = flush;
+  const RefinementResult r =
+      RefineOnGraspFace(depth, kCartonS, TopFace(gt), RefinementOptions{}, &pose);
+  ASSERT_TRUE(r.ok);
+  EXPECT_EQ(r.sides[0], SideKind::kFree);
+  EXPECT_EQ(r.sides[1], SideKind::kFree);
+  EXPECT_EQ(r.sides[2], SideKind::kFree);
+  EXPECT_EQ(r.sides[3], SideKind::kOccluded);
+  // Placed from the rim: its +y side where the face ends, 6 mm from the
+  // bulging carton's centre.
+  const PoseError e = ComparePoses(pose, gt.camera_T_box, bulging);
+  EXPECT_NEAR(e.translation_m, 0.006, 0.003);
+  EXPECT_LT(e.rotation_deg, 1.0);
+  // The rule off: the side runs on, and nothing measures the face across.
+  RefinementOptions off;
+  off.rim_beside_occluded = false;
+  pose = flush;
+  const RefinementResult r_off = RefineOnGraspFace(depth, kCartonS, TopFace(gt), off, &pose);
+  EXPECT_EQ(r_off.sides[2], SideKind::kContinues);
+  EXPECT_EQ(r_off.sides[3], SideKind::kOccluded);
+}
+
 // The same carton with a groove in its rim (a line of missing returns 3-6
 // mm past the reading's side, as an active stereo camera's noise leaves in
 // a fattened edge) and a colour image that shows the carton but no line
