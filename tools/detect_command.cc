@@ -159,6 +159,9 @@ constexpr char kHelp[] =
     "                       other sides end it and it is seen to the border longer\n"
     "                       than any shorter side of the box, over 60% of its length\n"
     "                       (true)\n"
+    "  --corner_out SHARE   a face at most SHARE of which lies past the border, every\n"
+    "                       side of it read, is judged as in view (0.1; 0: every\n"
+    "                       corner in view)\n"
     "  --score_in_view BOOL a box's score is its support times the share of its\n"
     "                       outline in the image: boxes partly out of view rank\n"
     "                       below those wholly in view (true)\n"
@@ -221,6 +224,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("border_faces", &options.faces.propose_at_border),
         args.SetInt("leaving_view", &options.acceptance.leaving_view_free_axes),
         args.SetBool("out_of_view", &options.acceptance.face_may_run_out_of_view),
+        args.SetDouble("corner_out", &options.acceptance.max_out_of_view_share),
         args.SetBool("score_in_view", &options.score_in_view),
         args.SetBool("kept_seams", &options.acceptance.kept_box_ends_side),
         args.SetBool("pairs", &options.acceptance.pairs_end_each_other),
@@ -356,6 +360,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "border_faces",
                                                        "leaving_view",
                                                        "out_of_view",
+                                                       "corner_out",
                                                        "score_in_view",
                                                        "kept_seams",
                                                        "pairs",

@@ -514,6 +514,7 @@ absl::Status AcceptanceOptions::Validate() const {
            CheckRange("acceptance.border_margin_px", border_margin_px, 0.0, 1000.0),
            CheckRange("acceptance.leaving_view_free_axes", leaving_view_free_axes, 0, 2),
            CheckPositive("acceptance.min_in_view_share", min_in_view_share, 1.0),
+           CheckRange("acceptance.max_out_of_view_share", max_out_of_view_share, 0.0, 0.99),
            CheckRange("acceptance.overlap_margin_m", overlap_margin_m, 0.0, 1.0),
            CheckRange("acceptance.settled_overlap_margin_m", settled_overlap_margin_m, 0.0, 1.0),
        }) {

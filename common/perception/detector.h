@@ -81,6 +81,14 @@ struct AcceptanceOptions {
   // a corner out of view hides nothing about where the box is. False: every
   // face in view, whole.
   bool measured_face_may_leave_view = true;
+  // A face no more than this share of which lies past the border (sampled
+  // on a 10 x 10 grid, border_margin_px in) is judged as in view, when the
+  // refinement read each of its sides (none unknown): a corner just past
+  // the border hides no more of its size than a side occluded does. A stereo
+  // heap's carton whose corner reached 6 px past the image's bottom, three
+  // sides free and one under a box in front, was declined. 0: every corner
+  // in view. Unitless, [0, 1).
+  double max_out_of_view_share = 0.1;
   // 1: one free side anywhere (a seam's turn is measured since the
   // fourteenth round); 2: a free side on each axis (the rule before session
   // 17); 0: seams on all four suffice. Count, [0, 2].

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "common/perception/box_pose.h"
+#include "common/perception/camera_model.h"
 #include "common/perception/internal/box_overlap.h"
 #include "common/perception/pose_error.h"
 #include "tests/support/scene_generator.h"
@@ -160,6 +161,56 @@ TEST(HypothesisJudgeTest, AHypothesisThroughTheFloorIsDeclinedWhenJudged) {
     EXPECT_FALSE(judge.JudgeAlone(gt, {}, &why).has_value());
     EXPECT_NE(why.find("into the floor"), std::string::npos) << why;
   }
+}
+
+// A carton whose grasp face has one corner a few pixels past the image's
+// left edge, one long side under a taller box standing in front of it (read
+// occluded) and the other three free: judged as in view
+// (AcceptanceOptions::max_out_of_view_share), it is accepted; with the rule
+// off, its face is cut by the border and not pinned on every side.
+TEST(HypothesisJudgeTest, AFaceWithACornerJustPastTheBorderIsJudgedAsInView) {
+  const BoxDims tall{0.30, 0.20, 0.35};
+  Eigen::Isometry3d carton = Eigen::Isometry3d::Identity();
+  carton.translation().z() = kCartonS.h / 2.0;
+  Eigen::Isometry3d in_front = Eigen::Isometry3d::Identity();
+  in_front.translation() = Eigen::Vector3d(0.0, -(kCartonS.b + tall.b) / 2.0 - 0.004, tall.h / 2.0);
+  Scene scene;
+  scene.world_T_camera = LookAtCamera(Eigen::Vector3d(0.0, 0.02, kCartonS.h), 1.3, -12.0, 8.0, 0.0);
+  scene.boxes = {{kCartonS, carton, true}, {tall, in_front, true}};
+  // The principal point that puts the face's leftmost corner 4 px past the
+  // left edge.
+  const RenderedDepth centred = RenderNoiseFree(scene);
+  const Eigen::Isometry3d& gt = centred.out.boxes.at(0).camera_T_box;
+  double u_min = 1e9;
+  for (const double sx : {-0.5, 0.5}) {
+    for (const double sy : {-0.5, 0.5}) {
+      const Eigen::Vector3d p =
+          gt * Eigen::Vector3d(sx * kCartonS.l, sy * kCartonS.b, kCartonS.h / 2);
+      u_min = std::min(u_min, Project(scene.camera, p).x());
+    }
+  }
+  scene.camera.cx -= u_min + 4.0;
+  const RenderedDepth b = RenderNoiseFree(scene);
+  const Eigen::Isometry3d& pose = b.out.boxes.at(0).camera_T_box;
+  for (const double share : {0.1, 0.0}) {
+    DetectorOptions o;
+    o.box = kCartonS;
+    o.acceptance.max_out_of_view_share = share;
+    internal::HypothesisJudge judge(b.depth, o);
+    std::string why;
+    const std::optional<internal::Candidate> c = judge.JudgeAlone(pose, {}, &why);
+    if (share > 0.0) {
+      ASSERT_TRUE(c.has_value()) << why;
+      EXPECT_EQ(c->refinement.free_sides, 3);
+      EXPECT_LT(ComparePoses(c->box.camera_T_box, pose, kCartonS).translation_m, 0.005);
+    } else {
+      EXPECT_FALSE(c.has_value());
+      EXPECT_EQ(why, "grasp face cut by the image border");
+    }
+  }
+  AcceptanceOptions bad;
+  bad.max_out_of_view_share = 1.0;  // the whole face out of view
+  EXPECT_NE(std::string(bad.Validate().message()).find("max_out_of_view_share"), std::string::npos);
 }
 
 // A hypothesis that overlaps a kept box by more than refinement can move it

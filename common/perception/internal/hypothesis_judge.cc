@@ -504,7 +504,14 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, const std::vector<DetectedB
   }
   SeamsAgainstKept(cand.box.camera_T_box, grasp, kept, &cand.refinement);
   // A face the border cuts: is it pinned up to the border?
-  const bool in_view = GraspFaceInView(cand.box.camera_T_box, grasp, acceptance.border_margin_px);
+  // Or a corner of it just past the border, its sides all read.
+  const bool in_view =
+      GraspFaceInView(cand.box.camera_T_box, grasp, acceptance.border_margin_px) ||
+      (acceptance.max_out_of_view_share > 0.0 &&
+       std::none_of(cand.refinement.sides.begin(), cand.refinement.sides.end(),
+                    [](SideKind k) { return k == SideKind::kUnknown; }) &&
+       GraspFaceOutOfView(cand.box.camera_T_box, grasp, acceptance.border_margin_px) <=
+           acceptance.max_out_of_view_share);
   const int out_of_view = OutOfViewSide(cand.box.camera_T_box, grasp, cand.refinement, in_view);
   // What the refinement alone rejects (most often a side that runs on flat:
   // two thirds of all refined hypotheses) needs no full evidence.
@@ -613,6 +620,22 @@ bool HypothesisJudge::GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace fac
     }
   }
   return true;
+}
+
+double HypothesisJudge::GraspFaceOutOfView(const Eigen::Isometry3d& pose, BoxFace face,
+                                           double margin) const {
+  const CameraIntrinsics& k = depth_.camera;
+  constexpr int kSteps = 10;
+  int out = 0;
+  for (int i = 0; i < kSteps; ++i) {
+    for (int j = 0; j < kSteps; ++j) {
+      const std::optional<Eigen::Vector2d> px =
+          GraspFacePixel(pose, face, (i + 0.5) / kSteps - 0.5, (j + 0.5) / kSteps - 0.5);
+      out += !px || px->x() < margin || px->y() < margin || px->x() > k.width - 1 - margin ||
+             px->y() > k.height - 1 - margin;
+    }
+  }
+  return static_cast<double>(out) / (kSteps * kSteps);
 }
 
 void HypothesisJudge::SeamsAgainstKept(const Eigen::Isometry3d& pose, BoxFace grasp,

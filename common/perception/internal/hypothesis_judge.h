@@ -197,6 +197,10 @@ class HypothesisJudge {
   std::optional<Eigen::Vector2d> GraspFacePixel(const Eigen::Isometry3d& pose, BoxFace face,
                                                 double sa, double sb) const;
   bool GraspFaceInView(const Eigen::Isometry3d& pose, BoxFace face, double margin) const;
+  // The share of the grasp face (a 10 x 10 grid of its points) that
+  // projects outside the image shrunk by `margin` pixels, or behind the
+  // camera.
+  double GraspFaceOutOfView(const Eigen::Isometry3d& pose, BoxFace face, double margin) const;
   // The grasp face's centre in view, and on `sides_in_view` of its sides a
   // point (at a quarter, half or three quarters of it).
   bool GraspFaceMeasurable(const Eigen::Isometry3d& pose, BoxFace face, int sides_in_view) const;
