@@ -682,6 +682,8 @@ absl::Status PrepareFrame(const PointCloud& input, const DetectorOptions& option
     options.clubbing.meet_along_view_factor = 1.0;
   }
   if (options.size_tolerance_m) ApplySizeTolerance(*options.size_tolerance_m, &options);
+  // Nothing else judges the turned reading of a face hidden on two sides.
+  if (!options.turned_check) options.acceptance.turned_hidden_corner_to_check = false;
   if (options.edge_lattice_radius_px > 0.0) {
     const double radius_px =
         median_z > 0.0 ? options.edge_points.radius_m * f->camera.fx / median_z : 0.0;

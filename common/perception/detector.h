@@ -63,6 +63,14 @@ struct AcceptanceOptions {
   // over it, read as a carton on its side). False: an unseen side says
   // nothing.
   bool check_unseen_sides = true;
+  // With two sides of the grasp face across each other hidden, the face
+  // turned a quarter (longer where it was shorter) could stand there too:
+  // true leaves that reading to DetectorOptions::turned_check, which
+  // judges it at the corner between the two measured sides and takes the
+  // box out when it is a box too; false declines every such box ("a
+  // hidden side could be a longer side of the box"), as before session 30.
+  // Off whenever turned_check is off.
+  bool turned_hidden_corner_to_check = true;
   // ... unless the depth image rules that longer reading out: at least this
   // share of the box so read (internal::LongerUnderSide) is seen
   // through, the camera seeing the floor past the shadow where the box

@@ -465,6 +465,33 @@ RefinementResult ReadWithOneUnseenSide(int unseen) {
   return ref;
 }
 
+// A carton_s top hidden on two sides across each other (+a, +b occluded:
+// a box in front at that corner) could be the face turned a quarter, 0.30
+// along b: with the turned check to judge that reading at the corner of
+// the two free sides (AcceptanceOptions::turned_hidden_corner_to_check),
+// the verdict leaves it to the check; without it, or with one of those two
+// sides not measured, the box is declined.
+TEST(RefinementVerdictTest, AFaceHiddenOnTwoSidesAcrossIsLeftToTheTurnedCheck) {
+  constexpr BoxDims kCartonS{0.30, 0.20, 0.15};
+  RefinementResult ref;
+  ref.ok = true;
+  ref.sides = {SideKind::kOccluded, SideKind::kFree, SideKind::kOccluded, SideKind::kFree};
+  ref.free_sides = 2;
+  AcceptanceOptions o;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusZ, o), "");
+  o.turned_hidden_corner_to_check = false;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusZ, o),
+            "a hidden side could be a longer side of the box");
+  // A seam and a free side make the corner too; one side tiled does not.
+  o.turned_hidden_corner_to_check = true;
+  ref.sides[1] = SideKind::kSeam;
+  ref.free_sides = 1;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusZ, o), "");
+  ref.sides[1] = SideKind::kTiled;
+  EXPECT_EQ(internal::RefinementVerdict(ref, kCartonS, BoxFace::kPlusZ, o),
+            "a hidden side could be a longer side of the box");
+}
+
 // A side with no point just inside it whose pixels see behind the plane
 // (RefinementResult::seen_through): the face ends before it, whatever the
 // other sides say; not where the side is out of view.

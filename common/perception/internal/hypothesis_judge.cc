@@ -83,11 +83,21 @@ std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, 
     const bool unseen = o.check_unseen_sides && ref.sides[s] == SideKind::kUnknown;
     if (!occluded && !unseen) continue;
     const int here = s < 2 ? axis_a : axis_b, other = s < 2 ? axis_b : axis_a;
+    // The side across hidden too: the face turned a quarter, unless the
+    // turned check judges that reading at the corner of the two sides
+    // opposite (both measured).
+    const int across = s < 2 ? 2 : 0;
+    auto ends = [&](int i) {
+      return ref.sides[i] == SideKind::kFree || ref.sides[i] == SideKind::kSeam;
+    };
+    const bool turned_in_doubt =
+        ref.sides[across] == SideKind::kOccluded &&
+        !(o.turned_hidden_corner_to_check && ends(s ^ 1) && ends(across ^ 1));
     for (int k = 0; k < 3; ++k) {
       if ((k != here && k != other && dims[k] > dims[here] + o.extent_tolerance_m &&
            (longer_ruled_out & (1u << s)) == 0) ||
           (occluded && k == other && dims[k] > dims[here] + o.extent_tolerance_m &&
-           ref.sides[s < 2 ? 2 : 0] == SideKind::kOccluded)) {
+           turned_in_doubt)) {
         return kLongerSide;
       }
     }
