@@ -396,6 +396,9 @@ TEST(RegressionTest, ACartonWithACornerOutOfViewIsFoundWhenEverySideIsMeasured) 
     DetectorOptions options;
     options.box = carton_l;
     options.acceptance.measured_face_may_leave_view = rule;
+    // A corner just past the border is judged as in view since session 30
+    // (max_out_of_view_share): off, to test this rule on its own.
+    options.acceptance.max_out_of_view_share = 0.0;
     const absl::StatusOr<Detection> det = DetectBoxes(r.cloud, options);
     ASSERT_TRUE(det.ok()) << det.status();
     int cut = 0;
@@ -431,6 +434,7 @@ TEST(RegressionTest, APalletCartonCutByTheBorderAndPinnedBySeamsIsFound) {
     DetectorOptions options;
     options.box = carton_s;
     options.acceptance.leaving_view_free_axes = free_axes;
+    options.acceptance.max_out_of_view_share = 0.0;  // this rule on its own
     const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
     ASSERT_TRUE(det.ok()) << det.status();
     int cut = 0;
@@ -776,6 +780,10 @@ TEST(RegressionTest, ALayerCutByTheBorderIsSplitAlongTheSeamsItShows) {
     DetectorOptions options;
     options.box = carton_flat;
     options.faces.seam_split.enabled = split;
+    // Without the split, a carton with a corner just past the border is
+    // found since session 30 (max_out_of_view_share): off, to test the
+    // split on its own.
+    options.acceptance.max_out_of_view_share = 0.0;
     const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
     if (!det.ok()) {
       ADD_FAILURE() << det.status();
