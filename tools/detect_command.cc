@@ -81,6 +81,8 @@ constexpr char kHelp[] =
     "                       aligned (true)\n"
     "  --turned_check BOOL  a box with a side not measured is taken out when its face\n"
     "                       turned a quarter at a measured corner is a box too (true)\n"
+    "  --corner_tilt BOOL   a corner's reading declined unrefined or moved too far is\n"
+    "                       judged again with its face on the depth's plane (true)\n"
     "  --turned_hidden BOOL a face hidden on two sides across each other is left to\n"
     "                       the turned check, not declined (true; off with the check)\n"
     "  --shifted_check BOOL a box seamed on both sides of an axis is taken out when\n"
@@ -213,6 +215,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("flush_layer", &options.flush_neighbour_is_layer),
         args.SetBool("turned_check", &options.turned_check),
         args.SetBool("turned_hidden", &options.acceptance.turned_hidden_corner_to_check),
+        args.SetBool("corner_tilt", &options.corner_tilt_onto_depth),
         args.SetBool("shifted_check", &options.shifted_check),
         args.SetBool("retake_outranked", &options.retake_outranked),
         args.SetBool("unseen_sides", &options.acceptance.check_unseen_sides),
@@ -348,6 +351,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "flush_layer",
                                                        "turned_check",
                                                        "turned_hidden",
+                                                       "corner_tilt",
                                                        "shifted_check",
                                                        "retake_outranked",
                                                        "unseen_sides",

@@ -221,6 +221,13 @@ struct DetectorOptions {
   // cannot separate (a tape edge taken for a seam makes a carton turned
   // across two). Faces whose sides differ by less than 2 cm are skipped.
   bool turned_check = true;
+  // A hypothesis from a corner that the first look turns away or that
+  // refinement moves too far is judged once more with its face turned onto
+  // the plane the depth image shows in the face's middle, when the two
+  // differ by 2-30 degrees (internal::TiltOntoDepth): the corner's segments
+  // set its normal, and an active stereo camera's depth noise along them
+  // tilts it by 15-20 degrees, more than refinement may turn it.
+  bool corner_tilt_onto_depth = true;
   // A box whose face is bounded by seams on both sides of one axis, with
   // fewer than two free sides, is taken out when its face shifted half its
   // width along that axis is judged a box with more free sides: the seams

@@ -213,6 +213,34 @@ TEST(HypothesisJudgeTest, AFaceWithACornerJustPastTheBorderIsJudgedAsInView) {
   EXPECT_NE(std::string(bad.Validate().message()).find("max_out_of_view_share"), std::string::npos);
 }
 
+// A corner hypothesis tilted 15 degrees off a carton's top (about an axis
+// in the face through its centre, as a segment's depth noise tilts it) is
+// turned back onto the depth's plane; one tilted 1 degree is left as it is,
+// and so is a face too small in the image to fit a plane to.
+TEST(HypothesisJudgeTest, ATiltedCornerReadingTurnsOntoTheDepthsPlane) {
+  const RenderedDepth b = RenderOneBox();
+  const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;
+  const Eigen::Vector3d top = gt.linear().col(2);  // the +z face, towards the camera
+  auto tilted = [&](double deg) {
+    const Eigen::Vector3d centre = gt * Eigen::Vector3d(0.0, 0.0, kCartonS.h / 2.0);
+    const Eigen::Matrix3d turn =
+        Eigen::AngleAxisd(deg * M_PI / 180.0, gt.linear().col(0)).toRotationMatrix();
+    Eigen::Isometry3d pose = gt;
+    pose.linear() = turn * gt.linear();
+    pose.translation() = centre + turn * (gt.translation() - centre);
+    return pose;
+  };
+  Eigen::Isometry3d pose = tilted(15.0);
+  ASSERT_TRUE(internal::TiltOntoDepth(b.depth, kCartonS, &pose));
+  EXPECT_LT(std::acos(std::min(1.0, pose.linear().col(2).dot(top))) * 180.0 / M_PI, 1.0);
+  EXPECT_LT((pose.translation() - gt.translation()).norm(), 0.01);
+  pose = tilted(1.0);
+  EXPECT_FALSE(internal::TiltOntoDepth(b.depth, kCartonS, &pose));
+  // A 4 cm cube's face spans ~17 px at 1.2 m: left as it is.
+  pose = tilted(15.0);
+  EXPECT_FALSE(internal::TiltOntoDepth(b.depth, BoxDims{0.04, 0.04, 0.04}, &pose));
+}
+
 // A hypothesis that overlaps a kept box by more than refinement can move it
 // (AcceptanceOptions::settled_overlap_margin_m, 5 cm on every side) is not
 // judged while the box is kept, and is judged when proposed again once the

@@ -1,8 +1,12 @@
 #include "common/perception/internal/hypothesis_judge.h"
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <mutex>
 #include <numbers>
@@ -26,6 +30,72 @@ constexpr char kNotBoxedIn[] = "no free side and not boxed in by seams on all fo
 constexpr char kLongerSide[] = "a hidden side could be a longer side of the box";
 
 }  // namespace
+
+bool TiltOntoDepth(const DepthImage& depth, const BoxDims& dims, Eigen::Isometry3d* pose) {
+  const Eigen::Matrix3d R = pose->linear();
+  const Eigen::Vector3d t = pose->translation();
+  // The face most facing the camera.
+  int best_axis = 0;
+  double best_sign = 1.0, best_facing = -2.0;
+  for (int i = 0; i < 3; ++i) {
+    for (const double sgn : {1.0, -1.0}) {
+      const Eigen::Vector3d n = sgn * R.col(i);
+      const Eigen::Vector3d c = t + n * dims[i] / 2.0;
+      const double facing = -c.normalized().dot(n);
+      if (facing > best_facing) best_facing = facing, best_axis = i, best_sign = sgn;
+    }
+  }
+  if (best_facing <= 0.2) return false;
+  const int ia = (best_axis + 1) % 3, ib = (best_axis + 2) % 3;
+  const Eigen::Vector3d n0 = best_sign * R.col(best_axis);
+  const Eigen::Vector3d c0 = t + n0 * dims[best_axis] / 2.0;
+  // A face a few dozen pixels across fits the noise, not its plane.
+  if (c0.z() <= 0.05 ||
+      std::min(dims[ia], dims[ib]) * depth.camera.fx / c0.z() < kTiltOntoDepthMinFacePx) {
+    return false;
+  }
+  std::vector<Eigen::Vector3d> pts;
+  const CameraIntrinsics& k = depth.camera;
+  for (int i = 0; i < 9; ++i) {
+    for (int j = 0; j < 9; ++j) {
+      const Eigen::Vector3d q = c0 + (0.8 * (i / 8.0 - 0.5)) * dims[ia] * R.col(ia) +
+                                (0.8 * (j / 8.0 - 0.5)) * dims[ib] * R.col(ib);
+      if (q.z() <= 0.05) return false;
+      const Eigen::Vector2d px = Project(k, q);
+      const int u = static_cast<int>(std::lround(px.x())),
+                v = static_cast<int>(std::lround(px.y()));
+      if (!depth.inside(u, v)) continue;
+      const float z = depth.at(u, v);
+      if (std::isnan(z)) continue;
+      pts.push_back(static_cast<double>(z) * PixelRay(k, u, v));
+    }
+  }
+  Eigen::Vector3d n = n0, c = c0;
+  for (const double tol : {0.04, 0.01}) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    int m = 0;
+    for (const Eigen::Vector3d& p : pts) {
+      if (std::abs((p - c).dot(n)) <= tol) mean += p, ++m;
+    }
+    if (m < 30) return false;
+    mean /= m;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const Eigen::Vector3d& p : pts) {
+      if (std::abs((p - c).dot(n)) <= tol) cov += (p - mean) * (p - mean).transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    Eigen::Vector3d fit = eig.eigenvectors().col(0);
+    if (fit.dot(n0) < 0.0) fit = -fit;
+    n = fit;
+    c = mean;
+  }
+  const double angle = std::acos(std::clamp(n.dot(n0), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+  if (angle < 2.0 || angle > 30.0) return false;
+  const Eigen::Matrix3d turn = Eigen::Quaterniond::FromTwoVectors(n0, n).toRotationMatrix();
+  pose->linear() = turn * R;
+  pose->translation() = c0 + turn * (t - c0);
+  return true;
+}
 
 std::string RefinementVerdict(const RefinementResult& ref, const BoxDims& dims, BoxFace grasp,
                               const AcceptanceOptions& o, int out_of_view_side,
@@ -466,14 +536,39 @@ std::optional<Candidate> HypothesisJudge::JudgeAlone(const Eigen::Isometry3d& ca
 
 bool HypothesisJudge::EvaluateOne(const Proposal& p, const std::vector<DetectedBox>& kept,
                                   Candidate* out, bool* refined, std::string* reason) const {
+  if (EvaluateFrom(p, p.camera_T_box, kept, out, refined, reason)) return true;
+  // A corner's reading the gate turned away or the refinement moved too
+  // far gets a second start with its face on the depth's plane
+  // (DetectorOptions::corner_tilt_onto_depth).
+  if (p.corners <= 0 || p.neighbour || !options_.corner_tilt_onto_depth ||
+      (*refined && *reason != kMovedTooFar)) {
+    return false;
+  }
+  Eigen::Isometry3d tilted = p.camera_T_box;
+  if (!TiltOntoDepth(depth_, options_.box, &tilted)) return false;
+  Candidate second;
+  bool refined_second = false;
+  std::string why;
+  const bool ok = EvaluateFrom(p, tilted, kept, &second, &refined_second, &why);
+  if (ok || (refined_second && !*refined)) {
+    *out = std::move(second);
+    *refined = refined_second;
+    *reason = std::move(why);
+  }
+  return ok;
+}
+
+bool HypothesisJudge::EvaluateFrom(const Proposal& p, const Eigen::Isometry3d& start,
+                                   const std::vector<DetectedBox>& kept, Candidate* out,
+                                   bool* refined, std::string* reason) const {
   Candidate& cand = *out;
-  cand.box.camera_T_box = p.camera_T_box;
+  cand.box.camera_T_box = start;
   cand.box.num_corners = p.corners;
   cand.box.segments = p.segments;
   cand.box.from_face = p.from_face;
   EvidenceOptions gate = options_.evidence;
   gate.max_samples = std::min(gate.max_samples, gate.gate_max_samples);
-  const BoxEvidence first = MeasureBox(depth_, p.camera_T_box, options_.box, gate);
+  const BoxEvidence first = MeasureBox(depth_, cand.box.camera_T_box, options_.box, gate);
   // Refinement moves a hypothesis by centimetres at most: one that the
   // depth image already rejects by a wide margin is not worth refining.
   const BoxFace grasp = first.grasp_face;
@@ -488,9 +583,10 @@ bool HypothesisJudge::EvaluateOne(const Proposal& p, const std::vector<DetectedB
   // of each of its sides need only be in view (a neighbour of a box found,
   // out past the image's edge).
   const AcceptanceOptions& acceptance = options_.acceptance;
-  if (!GraspFaceInView(p.camera_T_box, grasp, -20.0) &&
+  if (!GraspFaceInView(cand.box.camera_T_box, grasp, -20.0) &&
       !(acceptance.measured_face_may_leave_view &&
-        GraspFaceMeasurable(p.camera_T_box, grasp, acceptance.face_may_run_out_of_view ? 3 : 4))) {
+        GraspFaceMeasurable(cand.box.camera_T_box, grasp,
+                            acceptance.face_may_run_out_of_view ? 3 : 4))) {
     return false;
   }
   *refined = true;

@@ -87,6 +87,20 @@ std::string ThroughFloor(const Eigen::Isometry3d& camera_T_box, const BoxDims& d
                          const Eigen::Vector3d& normal, const Eigen::Vector3d& on_plane,
                          double tolerance_m);
 
+// A corner hypothesis's face turned onto the depth image's plane there:
+// the corner's two segments give the face's normal as their cross product,
+// and on an active stereo camera a segment's depth is noisy enough to tilt
+// a face by 15-20 degrees, more than refinement may turn it. The face most
+// facing the camera is fitted to the depth of its middle (a 9 x 9 grid over
+// its inner 80 %, within 4 cm of the face, then within 1 cm of that fit);
+// when the fitted normal differs by 2-30 degrees the box turns about the
+// face's centre onto it. Faces whose shorter side spans fewer than
+// kTiltOntoDepthMinFacePx pixels are left (a brick top at 2 m on a stereo
+// camera fits the noise, not its plane: boxes 11-15 degrees off). False
+// when the pose did not turn (DetectorOptions::corner_tilt_onto_depth).
+inline constexpr double kTiltOntoDepthMinFacePx = 40.0;
+bool TiltOntoDepth(const DepthImage& depth, const BoxDims& dims, Eigen::Isometry3d* pose);
+
 class HypothesisJudge {
  public:
   // A stopped `cancel` (may be null) leaves the rest of a queue unjudged.
@@ -182,6 +196,10 @@ class HypothesisJudge {
   // `kept`: the boxes kept so far (SeamsAgainstKept).
   bool EvaluateOne(const Proposal& p, const std::vector<DetectedBox>& kept, Candidate* out,
                    bool* refined, std::string* reason) const;
+  // EvaluateOne's judgement of `p` started from `start` instead of its pose.
+  bool EvaluateFrom(const Proposal& p, const Eigen::Isometry3d& start,
+                    const std::vector<DetectedBox>& kept, Candidate* out, bool* refined,
+                    std::string* reason) const;
   // RefinementVerdict of a refined face at `pose`; where that is a hidden
   // side a longer side could stand in, again with the longer readings the
   // depth rules out (LongerReadingsRuledOut, set in *longer_ruled_out for
