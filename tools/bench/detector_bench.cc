@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -44,7 +45,7 @@ struct Frame {
 };
 
 const Frame& TheFrame() {
-  static const Frame frame = [] {
+  static const Frame kFrame = [] {
     Frame f;
     const char* path = std::getenv("CORNERPOSE_BENCH_CLOUD");
     if (path != nullptr) {
@@ -66,7 +67,7 @@ const Frame& TheFrame() {
     f.truth = scene.boxes;
     return f;
   }();
-  return frame;
+  return kFrame;
 }
 
 DetectorOptions Options(bool reference, int threads) {
@@ -144,7 +145,7 @@ BENCHMARK(BM_Detect)
 // The clutter set: heaps and pallets of touching cartons (with boxes of
 // another size on them), Kinect and stereo, carton_s and carton_l, 3 seeds.
 const std::vector<Frame>& ClutterSet() {
-  static const std::vector<Frame> frames = [] {
+  static const std::vector<Frame> kFrames = [] {
     std::vector<Frame> out;
     struct Spec {
       testing::SensorKind sensor;
@@ -180,12 +181,13 @@ const std::vector<Frame>& ClutterSet() {
     }
     return out;
   }();
-  return frames;
+  return kFrames;
 }
 
 double Quantile(std::vector<double> v, double q) {
   std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[static_cast<size_t>(q * (v.size() - 1) + 0.5)];
+  return v.empty() ? 0.0
+                   : v[static_cast<size_t>(std::lround(q * static_cast<double>(v.size() - 1)))];
 }
 
 void BM_ClutterSet(benchmark::State& state) {
