@@ -31,18 +31,23 @@ struct FlatScene {
   DepthImage depth;
 };
 
-FlatScene RenderFlat(const std::vector<SceneBox>& boxes, double distance_m = 1.1) {
-  Scene scene;
-  scene.camera = CameraIntrinsics{};
-  scene.world_T_camera =
-      LookAtCamera(boxes.front().world_T_box.translation(), distance_m, 8.0, 25.0, 0.0);
-  scene.boxes = boxes;
+// The scene rendered with exact depth, and its depth image.
+FlatScene RenderExact(const Scene& scene) {
   NoiseOptions exact;
   exact.enabled = false;
   FlatScene s;
   s.rendered = Render(scene, exact);
   s.depth = MakeDepthImage(s.rendered.cloud, s.rendered.camera);
   return s;
+}
+
+FlatScene RenderFlat(const std::vector<SceneBox>& boxes, double distance_m = 1.1) {
+  Scene scene;
+  scene.camera = CameraIntrinsics{};
+  scene.world_T_camera =
+      LookAtCamera(boxes.front().world_T_box.translation(), distance_m, 8.0, 25.0, 0.0);
+  scene.boxes = boxes;
+  return RenderExact(scene);
 }
 
 SceneBox Flat(const BoxDims& dims, double x, double y, double z_bottom = 0.0) {
@@ -398,11 +403,9 @@ TEST(RefineOnGraspFaceTest, ASideUnderABoxStandingOnTheFaceIsNotFree) {
     scene.world_T_camera =
         LookAtCamera(Eigen::Vector3d(camera_x, 0.0, lower.h), 1.2, 5.0, 0.0, 0.0);
     scene.boxes = {under, over};
-    NoiseOptions exact;
-    exact.enabled = false;
-    const RenderedScene rendered = Render(scene, exact);
-    const DepthImage depth = MakeDepthImage(rendered.cloud, rendered.camera);
-    const GroundTruthBox& gt = rendered.boxes[0];
+    const FlatScene rendered = RenderExact(scene);
+    const DepthImage& depth = rendered.depth;
+    const GroundTruthBox& gt = rendered.rendered.boxes[0];
     // The reading: a carton_l on the visible 0.4 m of the lower top,
     // x in [-0.275, 0.125]; its +a side (box x) is the one under the upper box.
     Eigen::Isometry3d pose = Moved(gt.camera_T_box, -0.075, 0.0, 0.0);
@@ -480,11 +483,9 @@ TEST(RefineOnGraspFaceTest, ARimEndsTheFaceWhenItsOppositeSideIsOccluded) {
   scene.camera = CameraIntrinsics{};
   scene.world_T_camera = LookAtCamera(Eigen::Vector3d(0.0, 0.02, bulging.h), 1.3, -12.0, 8.0, 0.0);
   scene.boxes = {carton, in_front};
-  NoiseOptions exact;
-  exact.enabled = false;
-  const RenderedScene rendered = Render(scene, exact);
-  const DepthImage depth = MakeDepthImage(rendered.cloud, rendered.camera);
-  const GroundTruthBox& gt = rendered.boxes[0];
+  const FlatScene rendered = RenderExact(scene);
+  const DepthImage& depth = rendered.depth;
+  const GroundTruthBox& gt = rendered.rendered.boxes[0];
   // The reading flush with the occluded -y side: +y runs on by 12 mm.
   const Eigen::Isometry3d flush = Moved(gt.camera_T_box, 0.0, -0.006, 0.0);
   Eigen::Isometry3d pose = flush;
