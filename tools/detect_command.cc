@@ -107,7 +107,8 @@ constexpr char kHelp[] =
     "  --sparse_seam SHARE  a line where SHARE more of the returns are missing than\n"
     "                       beside it is a seam (a gap finer than a pixel; 0.05; 0: off)\n"
     "  --eroded_faces SHARE a planar patch smaller than a face but SHARE of it along\n"
-    "                       both sides proposes the face centred on it (0.65; 0: off)\n"
+    "                       both sides proposes the face centred on it (0.6; 0: off)\n"
+    "  --eroded_beside BOOL ... also when the outline tiles one way (true)\n"
     "  --merge_patches N    planar patches within N cells of each other on one plane\n"
     "                       are one (a face noise broke up; 2; 0: no merging)\n"
     "  --merged_pieces BOOL ... and the pieces so merged propose their faces too (two\n"
@@ -226,6 +227,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
         args.SetDouble("sparse_seam", &options.refinement.sparse_seam_missing),
         args.SetDouble("eroded_faces", &options.faces.min_eroded_share),
+        args.SetBool("eroded_beside", &options.faces.eroded_beside_tile),
         args.SetInt("merge_patches", &options.faces.patches.merge_gap_cells),
         args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides),
         args.SetInt("max_declined", &options.max_declined),
@@ -362,6 +364,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "seam_colour",
                                                        "sparse_seam",
                                                        "eroded_faces",
+                                                       "eroded_beside",
                                                        "merge_patches",
                                                        "tile_uncued",
                                                        "size_tolerance",

@@ -342,6 +342,24 @@ void ProposeFromPatch(const DepthImage& image, const PlanarPatches& patches, siz
   if (tilings.size() == 1) {
     propose(tilings[0]);
     in_play({tilings[0]});
+    if (o.eroded_beside_tile && o.min_eroded_share > 0.0) {
+      // A face of the box it is most of, its rim taken in by the
+      // segmentation (FaceProposalOptions::eroded_beside_tile).
+      for (int n = 0; n < 3; ++n) {
+        if (n == tilings[0].normal_axis) continue;
+        const int a = (n + 1) % 3, b = (n + 2) % 3;
+        for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {
+          const FaceTiling t{n, su, sv, 1, 1};
+          if (rect.width >= o.min_eroded_share * dims[su] &&
+              rect.height >= o.min_eroded_share * dims[sv] &&
+              (dims[su] > rect.width + o.size_tolerance_m ||
+               dims[sv] > rect.height + o.size_tolerance_m)) {
+            const Eigen::Isometry3d pose = TilePose(rect, t, dims, 0.0, 0.0);
+            if (on_patch(pose, t)) out.poses.push_back(pose);
+          }
+        }
+      }
+    }
     return;
   }
   // Several tilings fit: seam cues first, then the fewest boxes.

@@ -343,8 +343,33 @@ TEST(FaceProposalsTest, AnOutlineALittleSmallerThanAFaceProposesItCentred) {
   FaceProposalOptions off;
   off.min_eroded_share = 0.0;
   EXPECT_EQ(lying_centred(off), 0);
-  f.width = 0.18;  // under 0.65 of l
+  f.width = 0.17;  // under 0.6 of l
   EXPECT_EQ(lying_centred(FaceProposalOptions{}), 0);
+}
+
+// An outline of 0.29 x 0.14 m tiles as one standing carton's 0.30 x 0.15
+// side; it is also 0.7 of the lying carton's 0.30 x 0.20 top across, its
+// rim taken in: that top, centred on it, is proposed beside the tile
+// (FaceProposalOptions::eroded_beside_tile), and not with the option off.
+TEST(FaceProposalsTest, AnOutlineThatTilesProposesTheBiggerFaceItIsMostOfToo) {
+  LayerFrame f;
+  f.width = 0.29;
+  f.height = 0.14;
+  f.Render();
+  auto lying_centred = [&](const FaceProposalOptions& o) {
+    int n = 0;
+    for (const Eigen::Isometry3d& pose : ProposeFromFaces(f.image, kCarton, o).poses) {
+      const Eigen::Vector2d q = f.ToLayer(pose.translation().x(), pose.translation().y());
+      const Eigen::Vector3d h = pose.linear().col(2);
+      n += q.norm() < 0.01 && std::abs(h.z()) > 0.95;
+    }
+    return n;
+  };
+  FaceProposalOptions o;
+  ASSERT_EQ(TilingsOf(0.29, 0.14, kCarton, o).size(), 1u);
+  EXPECT_EQ(lying_centred(o), 1);
+  o.eroded_beside_tile = false;
+  EXPECT_EQ(lying_centred(o), 0);
 }
 
 // A carton's top within a few pixels of the image border (its patch within
