@@ -107,7 +107,7 @@ constexpr char kHelp[] =
     "  --sparse_seam SHARE  a line where SHARE more of the returns are missing than\n"
     "                       beside it is a seam (a gap finer than a pixel; 0.05; 0: off)\n"
     "  --eroded_faces SHARE a planar patch smaller than a face but SHARE of it along\n"
-    "                       both sides proposes the face centred on it (0.6; 0: off)\n"
+    "                       both sides proposes the face centred on it (0.65; 0: off)\n"
     "  --eroded_beside BOOL ... also when the outline tiles one way (true)\n"
     "  --merge_patches N    planar patches within N cells of each other on one plane\n"
     "                       are one (a face noise broke up; 2; 0: no merging)\n"

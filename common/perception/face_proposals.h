@@ -52,13 +52,15 @@ struct FaceProposalOptions {
   double max_gap_m = 0.005;
   // An outline smaller than a face but at least this share of it along
   // both sides proposes the face centred on it (its rim taken in by the
-  // segmentation); 0 proposes nothing from such outlines. 0.65 until
-  // session 30. Unitless.
-  double min_eroded_share = 0.6;
-  // ... also when the outline tiles (one tiling): a brick's top eroded by
-  // the normals' window (0.169 x 0.058 m of 0.19 x 0.09 at 1.7 m, seen
-  // 38 degrees off head-on by a time-of-flight camera) tiled as two of its
-  // end faces, and only they were proposed. The judge decides between them.
+  // segmentation); 0 proposes nothing from such outlines. 0.6 also found
+  // a time-of-flight brick at the image's edge (0.64 of its top across),
+  // but on a real stereo tabletop frame a box in the background, at the
+  // image's corner, that is none (session 30). Unitless.
+  double min_eroded_share = 0.65;
+  // ... also when the outline tiles (one tiling): a face's top eroded by
+  // the normals' window can tile as smaller faces of the box (a brick's
+  // top, 0.169 x 0.058 m of 0.19 x 0.09 at 1.7 m, tiled as two of its end
+  // faces), and only they were proposed. The judge decides between them.
   bool eroded_beside_tile = true;
   // A patch within a normal window of the image border whose outline is no
   // bigger than one face proposes the faces that fit it (never a layer's

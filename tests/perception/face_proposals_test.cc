@@ -343,7 +343,7 @@ TEST(FaceProposalsTest, AnOutlineALittleSmallerThanAFaceProposesItCentred) {
   FaceProposalOptions off;
   off.min_eroded_share = 0.0;
   EXPECT_EQ(lying_centred(off), 0);
-  f.width = 0.17;  // under 0.6 of l
+  f.width = 0.18;  // under 0.65 of l
   EXPECT_EQ(lying_centred(FaceProposalOptions{}), 0);
 }
 
