@@ -1378,16 +1378,14 @@ void TileContinuingSides(const DepthImage& depth, const BoxDims& dims, BoxFace g
 // bands and the hypothesis is declined for the side on flat (two thirds of
 // all refined hypotheses are). One the step moved further may read its
 // sides differently from where it lands.
-// RefinementOptions::first_step_give_up_factor: the first step moved the
-// reading so far that the steps after it would not bring it back.
-bool FarAfterFirstStep(const RefinementOptions& options, const Eigen::Isometry3d& pose,
-                       const Eigen::Isometry3d& initial) {
-  const double k = options.first_step_give_up_factor;
-  if (k <= 0.0) return false;
+// Whether `pose` moved from `initial` by more than `factor` times the
+// largest correction a refinement accepts (max_shift_m, max_turn_deg).
+bool MovedFurtherThan(const RefinementOptions& options, double factor,
+                      const Eigen::Isometry3d& pose, const Eigen::Isometry3d& initial) {
   const double turn_deg = Eigen::AngleAxisd(initial.linear().transpose() * pose.linear()).angle() *
                           180.0 / std::numbers::pi;
-  return (pose.translation() - initial.translation()).norm() > k * options.max_shift_m ||
-         turn_deg > k * options.max_turn_deg;
+  return (pose.translation() - initial.translation()).norm() > factor * options.max_shift_m ||
+         turn_deg > factor * options.max_turn_deg;
 }
 
 bool EndsOnFlat(const RefinementResult& result, const RefinementOptions& options,
@@ -1425,7 +1423,10 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
             options.extra_step_corner_move_m) {
       ++iterations;
     }
-    if (it == 0 && options.iterations > 1 && FarAfterFirstStep(options, pose, initial)) {
+    // RefinementOptions::first_step_give_up_factor: the steps after it
+    // would not bring it back.
+    if (it == 0 && options.iterations > 1 && options.first_step_give_up_factor > 0.0 &&
+        MovedFurtherThan(options, options.first_step_give_up_factor, pose, initial)) {
       return result;  // not ok: moved too far
     }
     if (it == 0 && options.iterations > 1 && EndsOnFlat(result, options, pose, initial)) {
@@ -1436,10 +1437,7 @@ RefinementResult RefineOnGraspFace(const DepthImage& depth, const BoxDims& dims,
   }
   // A reading that moved too far is not this box: its sides are not worth
   // the shadow and tiling checks (a third of all refinements end here).
-  const double shift = (pose.translation() - initial.translation()).norm();
-  const double turn_deg = Eigen::AngleAxisd(initial.linear().transpose() * pose.linear()).angle() *
-                          180.0 / std::numbers::pi;
-  if (shift > options.max_shift_m || turn_deg > options.max_turn_deg) return result;
+  if (MovedFurtherThan(options, 1.0, pose, initial)) return result;
   MarkShadowedSides(depth, dims, grasp_face, options, pose, result);
   TileContinuingSides(depth, dims, grasp_face, options, pose, result);
   MarkGapsPastFreeSides(depth, dims, grasp_face, options, pose, result);

@@ -202,8 +202,8 @@ class OrganizedScorer {
     Eigen::Vector3f centre = p;
     if (options_.denoise && m >= 3) {
       for (size_t k = 0; k < m; ++k) dz[k] = fz[k] - pz;
-      const float median =
-          internal::SelectKth(dz.data(), static_cast<int>(m), static_cast<int>(m / 2), scratch.data());
+      const float median = internal::SelectKth(dz.data(), static_cast<int>(m),
+                                               static_cast<int>(m / 2), scratch.data());
       centre = p * ((pz + median) / pz);
     }
     return UnitVectorSum(fx.data(), fy.data(), fz.data(), m, centre);

@@ -291,6 +291,21 @@ void ProposeFromPatch(const DepthImage& image, const PlanarPatches& patches, siz
     }
     out.layers.push_back(std::move(layer));
   };
+  // A face bigger than the outline on one of its axes (past the tolerance)
+  // but at least min_eroded_share of it on both: a face whose rim the
+  // segmentation took in (a stereo camera's noise, rounded edges) is
+  // centred on its outline.
+  auto bigger_than_outline = [&](const FaceTiling& t) {
+    return dims[t.axis_u] > rect.width + o.size_tolerance_m ||
+           dims[t.axis_v] > rect.height + o.size_tolerance_m;
+  };
+  auto propose_eroded = [&](const FaceTiling& t) {
+    if (o.min_eroded_share > 0.0 && rect.width >= o.min_eroded_share * dims[t.axis_u] &&
+        rect.height >= o.min_eroded_share * dims[t.axis_v]) {
+      const Eigen::Isometry3d pose = TilePose(rect, t, dims, 0.0, 0.0);
+      if (on_patch(pose, t)) out.poses.push_back(pose);
+    }
+  };
   const std::vector<FaceTiling> tilings = TilingsOf(rect.width, rect.height, dims, o);
   if (tilings.empty()) {
     // For the layer check only (nothing is proposed from it): an outline
@@ -315,16 +330,8 @@ void ProposeFromPatch(const DepthImage& image, const PlanarPatches& patches, siz
       const int a = (n + 1) % 3, b = (n + 2) % 3;
       for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {
         const FaceTiling t{n, su, sv, 1, 1};
-        if (dims[su] > rect.width + o.size_tolerance_m ||
-            dims[sv] > rect.height + o.size_tolerance_m) {
-          // Smaller than the face but most of it: a face whose rim the
-          // segmentation took in (a stereo camera's noise, rounded edges)
-          // is centred on its outline.
-          if (o.min_eroded_share > 0.0 && rect.width >= o.min_eroded_share * dims[su] &&
-              rect.height >= o.min_eroded_share * dims[sv]) {
-            const Eigen::Isometry3d pose = TilePose(rect, t, dims, 0.0, 0.0);
-            if (on_patch(pose, t)) out.poses.push_back(pose);
-          }
+        if (bigger_than_outline(t)) {
+          propose_eroded(t);
           continue;
         }
         for (double cu : {-1.0, 1.0}) {
@@ -342,22 +349,14 @@ void ProposeFromPatch(const DepthImage& image, const PlanarPatches& patches, siz
   if (tilings.size() == 1) {
     propose(tilings[0]);
     in_play({tilings[0]});
-    if (o.eroded_beside_tile && o.min_eroded_share > 0.0) {
-      // A face of the box it is most of, its rim taken in by the
-      // segmentation (FaceProposalOptions::eroded_beside_tile).
-      for (int n = 0; n < 3; ++n) {
-        if (n == tilings[0].normal_axis) continue;
-        const int a = (n + 1) % 3, b = (n + 2) % 3;
-        for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {
-          const FaceTiling t{n, su, sv, 1, 1};
-          if (rect.width >= o.min_eroded_share * dims[su] &&
-              rect.height >= o.min_eroded_share * dims[sv] &&
-              (dims[su] > rect.width + o.size_tolerance_m ||
-               dims[sv] > rect.height + o.size_tolerance_m)) {
-            const Eigen::Isometry3d pose = TilePose(rect, t, dims, 0.0, 0.0);
-            if (on_patch(pose, t)) out.poses.push_back(pose);
-          }
-        }
+    // Also a face of the box it is most of, its rim taken in
+    // (FaceProposalOptions::eroded_beside_tile).
+    for (int n = 0; n < 3 && o.eroded_beside_tile; ++n) {
+      if (n == tilings[0].normal_axis) continue;
+      const int a = (n + 1) % 3, b = (n + 2) % 3;
+      for (const auto& [su, sv] : {std::pair{a, b}, std::pair{b, a}}) {
+        const FaceTiling t{n, su, sv, 1, 1};
+        if (bigger_than_outline(t)) propose_eroded(t);
       }
     }
     return;
