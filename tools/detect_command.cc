@@ -109,6 +109,8 @@ constexpr char kHelp[] =
     "  --eroded_faces SHARE a planar patch smaller than a face but SHARE of it along\n"
     "                       both sides proposes the face centred on it (0.65; 0: off)\n"
     "  --eroded_beside BOOL ... also when the outline tiles one way (true)\n"
+    "  --edge_pairs BOOL    two parallel edge segments a side of the box apart propose\n"
+    "                       the face between them (true)\n"
     "  --merge_patches N    planar patches within N cells of each other on one plane\n"
     "                       are one (a face noise broke up; 2; 0: no merging)\n"
     "  --merged_pieces BOOL ... and the pieces so merged propose their faces too (two\n"
@@ -228,6 +230,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetDouble("sparse_seam", &options.refinement.sparse_seam_missing),
         args.SetDouble("eroded_faces", &options.faces.min_eroded_share),
         args.SetBool("eroded_beside", &options.faces.eroded_beside_tile),
+        args.SetBool("edge_pairs", &options.edge_pairs.enabled),
         args.SetInt("merge_patches", &options.faces.patches.merge_gap_cells),
         args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides),
         args.SetInt("max_declined", &options.max_declined),
@@ -380,6 +383,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "pairs",
                                                        "seen_through",
                                                        "empty_window",
+                                                       "edge_pairs",
                                                        "anchored_faces",
                                                        "seam_split",
                                                        "merged_pieces",

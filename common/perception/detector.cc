@@ -525,9 +525,10 @@ absl::Status AcceptanceOptions::Validate() const {
 
 absl::Status DetectorOptions::Validate() const {
   if (absl::Status s = box.Validate(); !s.ok()) return s;
-  for (absl::Status s : {edge_points.Validate(), segments.Validate(), clubbing.Validate(),
-                         pose.Validate(), refinement.Validate(), evidence.Validate(),
-                         acceptance.Validate(), faces.Validate(), layer_plane.Validate()}) {
+  for (absl::Status s :
+       {edge_points.Validate(), segments.Validate(), clubbing.Validate(), pose.Validate(),
+        refinement.Validate(), evidence.Validate(), acceptance.Validate(), faces.Validate(),
+        layer_plane.Validate(), edge_pairs.Validate()}) {
     if (!s.ok()) return s;
   }
   if (empty_frame_window_cells < 0 || empty_frame_window_cells > 8) {
@@ -990,18 +991,33 @@ class BoxAcceptance {
   std::vector<Eigen::Isometry3d> outranked_;
 };
 
+// The faces between parallel edges (edge_pair_faces.h), queued after the
+// face tiles and judged in one batch with them: the ranking picks between a
+// pair's reading and a tiling's, and where both propose one pose (the queue
+// keeps the first) it is judged as the tile it also is.
+void ProposeEdgePairs(const std::vector<EdgePairFace>& pairs, const BoxAcceptance& acceptance,
+                      internal::HypothesisJudge* judge) {
+  for (const EdgePairFace& pair : pairs) {
+    if (!acceptance.OverlapsKept(pair.camera_T_box)) {
+      judge->Propose(pair.camera_T_box, 0, {pair.segment_a, pair.segment_b});
+    }
+  }
+}
+
 // Phase 5: the face tiles (after the corner hypotheses: a tile on a box
 // already found is not judged again), then the plausibility checks; where
 // they took a box out, the layers' own tiles get their turn, and what that
 // accepts is checked again (a few rounds, then a last check with nothing
 // proposed).
 void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
+                             const std::vector<EdgePairFace>& pairs,
                              internal::HypothesisJudge* judge, BoxAcceptance* acceptance,
                              Detection* det, std::vector<DeclinedCandidate>* declined) {
   const DetectorOptions& options = f.options;
   for (const Eigen::Isometry3d& pose : faces.poses) {
     if (!acceptance->OverlapsKept(pose)) judge->Propose(pose, 0, {}, true);
   }
+  ProposeEdgePairs(pairs, *acceptance, judge);
   for (const DeclinedCandidate& d : faces.declined) {
     declined->push_back(d);
     declined->back().score =
@@ -1067,9 +1083,14 @@ absl::Status JudgeAndKeep(const PreparedFrame& frame, const SegmentGroups& group
   BoxAcceptance acceptance(options, cancel, &judge, det);
   ProposeFromCorners(*det, groups, options, &judge);
   acceptance.AcceptAll();
+  const std::vector<EdgePairFace> pairs =
+      ProposeFromEdgePairs(det->segments, options.box, options.edge_pairs);
   std::vector<DeclinedCandidate> declined;
   if (options.face_proposals) {
-    AcceptFaceTilesAndCheck(frame, faces, &judge, &acceptance, det, &declined);
+    AcceptFaceTilesAndCheck(frame, faces, pairs, &judge, &acceptance, det, &declined);
+  } else if (!pairs.empty()) {
+    ProposeEdgePairs(pairs, acceptance, &judge);
+    acceptance.AcceptAll();
   }
   AlignToLayerPlanes(frame.depth, options.box, options.layer_plane, &det->boxes);
   if (absl::Status s = cancel.Check("the judging of hypotheses"); !s.ok()) return s;

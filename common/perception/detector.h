@@ -12,6 +12,7 @@
 #include "common/perception/box_refinement.h"
 #include "common/perception/cancel_token.h"
 #include "common/perception/clubbing.h"
+#include "common/perception/edge_pair_faces.h"
 #include "common/perception/edge_points.h"
 #include "common/perception/edge_segments.h"
 #include "common/perception/face_proposals.h"
@@ -171,6 +172,10 @@ struct DetectorOptions {
   // with the corner ones. False gives the corner-only detector.
   bool face_proposals = true;
   FaceProposalOptions faces;
+  // Faces between two parallel edge segments a side of the box apart
+  // (edge_pair_faces.h), judged with the face tiles: a box in a heap whose
+  // long sides show as edges and whose corners do not.
+  EdgePairOptions edge_pairs;
   // A frame in which nothing is found has its planar patches found once
   // more with the normal window this wide (cells; PlanarPatchOptions::
   // window_cells), unless the caller set that window, and its hypotheses

@@ -24,6 +24,14 @@ nlohmann::json Pose(const Eigen::Isometry3d& pose) {
   return rows;
 }
 
+// What proposed a box: a corner of edge segments, a planar patch's tiling,
+// two parallel edge segments (no corner), or a box found beside it.
+const char* ProposedBy(const DetectedBox& box) {
+  if (box.from_face) return "face";
+  if (box.num_corners > 0) return "corner";
+  return box.segments.empty() ? "neighbour" : "edges";
+}
+
 }  // namespace
 
 nlohmann::json DetectionToJson(const Detection& detection, const BoxDims& dims) {
@@ -41,7 +49,7 @@ nlohmann::json DetectionToJson(const Detection& detection, const BoxDims& dims) 
                      {"num_corners", box.num_corners},
                      {"segments", box.segments},
                      {"measured_extent", {box.measured_extent_m[0], box.measured_extent_m[1]}},
-                     {"proposed_by", box.from_face ? "face" : "corner"}});
+                     {"proposed_by", ProposedBy(box)}});
     detections.push_back({{"pose", Pose(box.camera_T_box)}, {"score", box.score}});
   }
   out["boxes"] = std::move(boxes);

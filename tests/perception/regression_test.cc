@@ -634,6 +634,7 @@ TEST(RegressionTest, ABoxOfAnotherSizeReadOnEndReachesIntoANoisyFloor) {
     if (!check) {
       options.refinement.extra_step_corner_move_m = 0.0;
       options.turned_proposals = false;
+      options.edge_pairs.enabled = false;  // the face between its edges too
     }
     const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
     ASSERT_TRUE(det.ok()) << det.status();
@@ -744,9 +745,11 @@ TEST(RegressionTest, AFaceStillTurningAfterTwoStepsGetsAThird) {
     DetectorOptions options;
     options.box = carton_l;
     options.refinement.extra_step_corner_move_m = corner_move;
-    // The turned readings of the declined hypotheses find these cartons
-    // as well: without them, the step alone.
+    // The turned readings of the declined hypotheses and the faces between
+    // parallel edges find these cartons as well: without them, the step
+    // alone.
     options.turned_proposals = false;
+    options.edge_pairs.enabled = false;
     const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
     if (!det.ok()) {
       ADD_FAILURE() << det.status();
@@ -1054,9 +1057,11 @@ TEST(RegressionTest, CornersOfStereoBricksMeetAcrossTheirDepthNoise) {
   ASSERT_TRUE(frame.ok()) << frame.status();
   const RenderedScene& r = *frame;
   const PointCloud cloud = RoundedToMillimetres(r);
-  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
-      cloud, r, brick,
-      [](bool on, DetectorOptions* o) { o->clubbing.meet_along_view_factor = on ? 3.0 : 1.0; });
+  const std::array<Detection, 2> det =
+      DetectedWithRuleOffAndOn(cloud, r, brick, [](bool on, DetectorOptions* o) {
+        o->clubbing.meet_along_view_factor = on ? 3.0 : 1.0;
+        o->edge_pairs.enabled = false;  // they find the bricks' faces between their edges too
+      });
   EXPECT_GT(det[1].corners.size(), det[0].corners.size());
   EXPECT_EQ(det[1].boxes.size(), det[0].boxes.size() + 2);
   // Without its colour image the frame keeps the paper's sphere at the
@@ -1182,6 +1187,7 @@ TEST(RegressionTest, ABrickBesideALevelOneSetOffAlongItIsFound) {
       DetectedWithRuleOffAndOn(RoundedToMillimetres(r), r, brick, [](bool on, DetectorOptions* o) {
         o->refinement.side_ends_share = on ? 0.35 : 0.55;
         o->refinement.seam_depth_per_rms = 0.0;  // session 29's groove rule, measured apart
+        o->edge_pairs.enabled = false;           // the face between its edges finds it too
       });
   EXPECT_EQ(det[1].boxes.size(), det[0].boxes.size() + 1);
 }

@@ -109,6 +109,7 @@ TEST_F(DetectionWritersTest, JsonHoldsPoseRowMajorAndScorerDetections) {
   EXPECT_EQ(j["boxes"][0]["grasp_face"], "+z");
   EXPECT_EQ(j["boxes"][0]["grasp_centre"], nlohmann::json({0.0, 0.0, 0.9}));
   EXPECT_EQ(j["boxes"][0]["num_corners"], 1);
+  EXPECT_EQ(j["boxes"][0]["proposed_by"], "corner");
   EXPECT_DOUBLE_EQ(j["boxes"][0]["score"].get<double>(), 0.875);
 
   ASSERT_EQ(j["edges"].size(), 1u);
@@ -126,6 +127,26 @@ TEST_F(DetectionWritersTest, JsonHoldsPoseRowMajorAndScorerDetections) {
   EXPECT_EQ(j["detections"][0]["pose"], pose);
   EXPECT_DOUBLE_EQ(j["detections"][0]["score"].get<double>(), 0.875);
   EXPECT_DOUBLE_EQ(j["time_s"].get<double>(), 0.0155);
+}
+
+// What proposed each box: a planar patch, a corner, two parallel edges (a
+// segment pair and no corner), or a box found beside it (neither).
+TEST_F(DetectionWritersTest, JsonSaysWhatProposedEachBox) {
+  Detection d = detection_;
+  d.boxes.resize(4, detection_.boxes[0]);
+  d.boxes[0].from_face = true;
+  d.boxes[2].num_corners = 0;
+  d.boxes[2].segments = {0, 1};
+  d.boxes[3].num_corners = 0;
+  d.boxes[3].segments.clear();
+  ASSERT_TRUE(WriteDetectionJson(Path("p.json"), d, dims_).ok());
+  std::ifstream in(Path("p.json"));
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["boxes"].size(), 4u);
+  EXPECT_EQ(j["boxes"][0]["proposed_by"], "face");
+  EXPECT_EQ(j["boxes"][1]["proposed_by"], "corner");
+  EXPECT_EQ(j["boxes"][2]["proposed_by"], "edges");
+  EXPECT_EQ(j["boxes"][3]["proposed_by"], "neighbour");
 }
 
 TEST_F(DetectionWritersTest, JsonOfAnEmptyDetectionHasEmptyLists) {
