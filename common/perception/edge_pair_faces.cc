@@ -32,13 +32,13 @@ std::vector<EdgePairFace> ProposeFromEdgePairs(const std::vector<EdgeSegment>& s
   for (int i = 0; i < n; ++i) {
     const EdgeSegment& si = segments[i];
     const double len_i = si.length();
-    if (len_i < o.min_length_m) continue;
+    if (!(len_i >= o.min_length_m && std::isfinite(len_i))) continue;  // NaN fails too
     const Eigen::Vector3d a0 = si.end1.cast<double>(), a1 = si.end2.cast<double>();
     const Eigen::Vector3d di = (a1 - a0) / len_i;
     for (int j = i + 1; j < n; ++j) {
       const EdgeSegment& sj = segments[j];
       const double len_j = sj.length();
-      if (len_j < o.min_length_m) continue;
+      if (!(len_j >= o.min_length_m && std::isfinite(len_j))) continue;
       Eigen::Vector3d b0 = sj.end1.cast<double>(), b1 = sj.end2.cast<double>();
       Eigen::Vector3d dj = (b1 - b0) / len_j;
       if (di.dot(dj) < 0.0) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -98,6 +99,10 @@ TEST(EdgePairFacesTest, SegmentsThatAreNoFacesOppositeSidesProposeNothing) {
   far.end1 += away;
   far.end2 += away;
   EXPECT_TRUE(ProposeFromEdgePairs({a, far}, kBrick, EdgePairOptions{}).empty());
+  // A segment with no coordinates (NaN) pairs with nothing.
+  EdgeSegment nan = Side(brick, -1, -half, half);
+  nan.end1.x() = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_TRUE(ProposeFromEdgePairs({a, nan}, kBrick, EdgePairOptions{}).empty());
   // Off: nothing, even from the brick's own sides.
   EdgePairOptions off;
   off.enabled = false;
