@@ -111,6 +111,8 @@ constexpr char kHelp[] =
     "  --eroded_beside BOOL ... also when the outline tiles one way (true)\n"
     "  --edge_pairs BOOL    two parallel edge segments a side of the box apart propose\n"
     "                       the face between them (true)\n"
+    "  --border_band BOOL   a face cut by the image border: the view ends where a run of\n"
+    "                       pixels with no return reaches the border (true)\n"
     "  --merge_patches N    planar patches within N cells of each other on one plane\n"
     "                       are one (a face noise broke up; 2; 0: no merging)\n"
     "  --merged_pieces BOOL ... and the pieces so merged propose their faces too (two\n"
@@ -231,6 +233,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetDouble("eroded_faces", &options.faces.min_eroded_share),
         args.SetBool("eroded_beside", &options.faces.eroded_beside_tile),
         args.SetBool("edge_pairs", &options.edge_pairs.enabled),
+        args.SetBool("border_band", &options.acceptance.border_band_ends_view),
         args.SetInt("merge_patches", &options.faces.patches.merge_gap_cells),
         args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides),
         args.SetInt("max_declined", &options.max_declined),
@@ -384,6 +387,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "seen_through",
                                                        "empty_window",
                                                        "edge_pairs",
+                                                       "border_band",
                                                        "anchored_faces",
                                                        "seam_split",
                                                        "merged_pieces",

@@ -113,6 +113,12 @@ struct AcceptanceOptions {
   bool face_may_run_out_of_view = true;
   // Share of the cut side's length that must be in view. Unitless, (0, 1].
   double min_in_view_share = 0.6;
+  // ... the view ending, for that test, where a run of pixels with no
+  // return reaches the border: the band along one side of an active
+  // stereo camera's image where it returns nothing. The face must still be
+  // seen, on its plane, past every shorter side that could stand there.
+  // False: those pixels count as not on the face.
+  bool border_band_ends_view = true;
   // A side the refinement finds running on flat (no seam in depth or
   // colour) is a seam where it lies against the grasp face of a box already
   // kept, coplanar and aligned with it (internal/kept_neighbours.h): in a

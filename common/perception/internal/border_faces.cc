@@ -24,6 +24,7 @@ bool Measured(SideKind k) { return k == SideKind::kFree || k == SideKind::kSeam;
 int SideOutOfViewPinned(const DepthImage& depth, const Eigen::Isometry3d& camera_T_box,
                         BoxFace grasp, const BoxDims& dims, const RefinementResult& ref,
                         const AcceptanceOptions& o, double plane_tolerance_m) {
+  const bool border_band_ends_view = o.border_band_ends_view;
   int open = -1;
   for (int s = 0; s < 4; ++s) {
     if (Measured(ref.sides[s])) continue;
@@ -60,34 +61,62 @@ int SideOutOfViewPinned(const DepthImage& depth, const Eigen::Isometry3d& camera
            px.y() <= k.height - 1 - margin;
   };
   double seen = std::numeric_limits<double>::infinity();
+  bool any_past_shorter = false;
   for (const double w : {-0.3, 0.0, 0.3}) {
     // From the measured end (t = 0) toward the side out of view.
     int on = 0, samples = 0, decisive_on = 0, decisive = 0;
     double last_in_view = 0.0;
+    // The run of samples with no return just before the border (an active
+    // stereo camera returns nothing in a band along one side of its
+    // image): the view ends where it starts.
+    int no_return_run = 0, no_return_decisive = 0;
+    double last_return = 0.0;
+    bool left_view = false;
     for (double t = 0.5 * kStepM; t <= dims[here]; t += kStepM) {
       Eigen::Vector3d local = face_centre;
       local[here] = sign * (t - 0.5 * dims[here]);
       local[other] = w * dims[other];
       const Eigen::Vector3d q = camera_T_box * local;
-      if (!in_view(q)) break;
+      if (!in_view(q)) {
+        left_view = true;
+        break;
+      }
       last_in_view = t;
       const std::optional<double> h = HeightAt(depth, q, normal);
       const bool on_plane = h && !std::isnan(*h) && std::abs(*h) <= plane_tolerance_m;
+      const bool no_return = h && std::isnan(*h);
       ++samples;
       on += on_plane;
       if (t > shorter + tol) {
         ++decisive;
         decisive_on += on_plane;
       }
+      if (no_return) {
+        ++no_return_run;
+        no_return_decisive += t > shorter + tol;
+      } else {
+        no_return_run = no_return_decisive = 0;
+        last_return = t;
+      }
     }
     // The line must leave the view before the face's side: that side is
     // out of view, not unseen in it.
-    if (last_in_view >= dims[here] - kStepM) return -1;
+    if (!left_view || last_in_view >= dims[here] - kStepM) return -1;
+    if (border_band_ends_view) {
+      samples -= no_return_run;
+      decisive -= no_return_decisive;
+      last_in_view = last_return;
+    }
     if (samples == 0 || on < kMinOnPlaneShare * samples) return -1;
-    if (shorter > 0.0 && (decisive < 2 || decisive_on < kMinOnPlaneShare * decisive)) return -1;
+    // Past every shorter side, on its plane: no other face of the box.
+    // One line suffices (the border may cut the face aslant, and the
+    // measured sides fix its turn); every line must be on the plane.
+    any_past_shorter = any_past_shorter || shorter == 0.0 ||
+                       (decisive >= 2 && decisive_on >= kMinOnPlaneShare * decisive &&
+                        last_in_view > shorter + tol);
     seen = std::min(seen, last_in_view);
   }
-  if (seen <= shorter + tol || seen < o.min_in_view_share * dims[here]) return -1;
+  if (!any_past_shorter || seen < o.min_in_view_share * dims[here]) return -1;
   return open;
 }
 
