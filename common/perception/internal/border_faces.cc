@@ -24,7 +24,6 @@ bool Measured(SideKind k) { return k == SideKind::kFree || k == SideKind::kSeam;
 int SideOutOfViewPinned(const DepthImage& depth, const Eigen::Isometry3d& camera_T_box,
                         BoxFace grasp, const BoxDims& dims, const RefinementResult& ref,
                         const AcceptanceOptions& o, double plane_tolerance_m) {
-  const bool border_band_ends_view = o.border_band_ends_view;
   int open = -1;
   for (int s = 0; s < 4; ++s) {
     if (Measured(ref.sides[s])) continue;
@@ -102,7 +101,7 @@ int SideOutOfViewPinned(const DepthImage& depth, const Eigen::Isometry3d& camera
     // The line must leave the view before the face's side: that side is
     // out of view, not unseen in it.
     if (!left_view || last_in_view >= dims[here] - kStepM) return -1;
-    if (border_band_ends_view) {
+    if (o.border_band_ends_view) {
       samples -= no_return_run;
       decisive -= no_return_decisive;
       last_in_view = last_return;
