@@ -1043,6 +1043,25 @@ TEST(RegressionTest, ABrickWhoseLongerReadingTheFloorRulesOutIsFound) {
   EXPECT_EQ(det[1].boxes.size(), det[0].boxes.size() + 2);
 }
 
+// Was: a stereo carton at the image's left border, three sides free, was
+// declined as cut by the border: toward the border the face showed on its
+// plane, then 4 cm of the stereo camera's band with no return, counted as
+// off the face, so no line saw it past the 0.25 m of the box's other face.
+// The band now ends the view (AcceptanceOptions::border_band_ends_view).
+// Stereo carton_l s8 heap_005 of scripts/evaluate: one box more, none
+// wrong either way.
+TEST(RegressionTest, AStereoCartonCutByTheBorderBesideItsBandOfNoReturnsIsFound) {
+  const BoxDims carton_l{0.40, 0.30, 0.25};
+  const absl::StatusOr<RenderedScene> frame =
+      SensorFrame(SensorKind::kStereo, true, "heap", carton_l, 5, 8005);
+  ASSERT_TRUE(frame.ok()) << frame.status();
+  const RenderedScene& r = *frame;
+  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
+      RoundedToMillimetres(r), r, carton_l,
+      [](bool on, DetectorOptions* o) { o->acceptance.border_band_ends_view = on; });
+  EXPECT_EQ(det[1].boxes.size(), det[0].boxes.size() + 1);
+}
+
 // Was: in a stereo heap of bricks at 1.6 m, bricks outlined by edge
 // segments on every side had no corner: the two lines of a corner passed
 // 1-3 cm apart in depth (the camera's noise, along the line of sight),
