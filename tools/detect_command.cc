@@ -113,6 +113,8 @@ constexpr char kHelp[] =
     "                       the face between them (true)\n"
     "  --border_band BOOL   a face cut by the image border: the view ends where a run of\n"
     "                       pixels with no return reaches the border (true)\n"
+    "  --floor_faces BOOL   judge face proposals that lie on the floor found (false: they\n"
+    "                       would reach into it)\n"
     "  --merge_patches N    planar patches within N cells of each other on one plane\n"
     "                       are one (a face noise broke up; 2; 0: no merging)\n"
     "  --merged_pieces BOOL ... and the pieces so merged propose their faces too (two\n"
@@ -234,6 +236,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("eroded_beside", &options.faces.eroded_beside_tile),
         args.SetBool("edge_pairs", &options.edge_pairs.enabled),
         args.SetBool("border_band", &options.acceptance.border_band_ends_view),
+        args.SetBool("floor_faces", &options.judge_faces_on_floor),
         args.SetInt("merge_patches", &options.faces.patches.merge_gap_cells),
         args.SetBool("tile_uncued", &options.refinement.tile_uncued_sides),
         args.SetInt("max_declined", &options.max_declined),
@@ -388,6 +391,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "empty_window",
                                                        "edge_pairs",
                                                        "border_band",
+                                                       "floor_faces",
                                                        "anchored_faces",
                                                        "seam_split",
                                                        "merged_pieces",

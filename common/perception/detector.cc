@@ -991,6 +991,24 @@ class BoxAcceptance {
   std::vector<Eigen::Isometry3d> outranked_;
 };
 
+// A face proposal on the floor itself: every corner of the box at most
+// 1.5 cm above the floor's plane and the deepest more than the floor's
+// tolerance and 2 cm beyond it. Refinement fits the face to the depth
+// there, the floor, so the box stays through it and is declined when
+// judged ("would reach ... into the floor"): a planar patch of the floor
+// tiles into box faces, and a noisy one's seam lines frame hundreds.
+bool FaceOnTheFloor(const Eigen::Isometry3d& pose, const BoxDims& dims, const FloorPlane& floor,
+                    double tolerance_m) {
+  double highest = -std::numeric_limits<double>::infinity();
+  double deepest = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& c : BoxCorners(pose, dims)) {
+    const double h = floor.normal.dot(c - floor.centroid);
+    highest = std::max(highest, h);
+    deepest = std::min(deepest, h);
+  }
+  return highest <= 0.015 && deepest < -(tolerance_m + 0.02);
+}
+
 // The faces between parallel edges (edge_pair_faces.h), queued after the
 // face tiles and judged in one batch with them: the ranking picks between a
 // pair's reading and a tiling's, and where both propose one pose (the queue
@@ -1011,11 +1029,17 @@ void ProposeEdgePairs(const std::vector<EdgePairFace>& pairs, const BoxAcceptanc
 // proposed).
 void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
                              const std::vector<EdgePairFace>& pairs,
+                             const std::optional<FloorPlane>& floor,
                              internal::HypothesisJudge* judge, BoxAcceptance* acceptance,
                              Detection* det, std::vector<DeclinedCandidate>* declined) {
   const DetectorOptions& options = f.options;
+  auto worth_judging = [&](const Eigen::Isometry3d& pose) {
+    return !acceptance->OverlapsKept(pose) &&
+           !(floor && !options.judge_faces_on_floor &&
+             FaceOnTheFloor(pose, options.box, *floor, options.floor_tolerance_m));
+  };
   for (const Eigen::Isometry3d& pose : faces.poses) {
-    if (!acceptance->OverlapsKept(pose)) judge->Propose(pose, 0, {}, true);
+    if (worth_judging(pose)) judge->Propose(pose, 0, {}, true);
   }
   ProposeEdgePairs(pairs, *acceptance, judge);
   for (const DeclinedCandidate& d : faces.declined) {
@@ -1048,7 +1072,7 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
   for (int round = 0; round < 3 && check(); ++round) {
     for (const LayerTiles& layer : faces.layers) {
       for (const Eigen::Isometry3d& tile : layer.tiles) {
-        if (!acceptance->OverlapsKept(tile)) judge->Propose(tile, 0, {}, true);
+        if (worth_judging(tile)) judge->Propose(tile, 0, {}, true);
       }
     }
     acceptance->AcceptAll();
@@ -1087,7 +1111,7 @@ absl::Status JudgeAndKeep(const PreparedFrame& frame, const SegmentGroups& group
       ProposeFromEdgePairs(det->segments, options.box, options.edge_pairs);
   std::vector<DeclinedCandidate> declined;
   if (options.face_proposals) {
-    AcceptFaceTilesAndCheck(frame, faces, pairs, &judge, &acceptance, det, &declined);
+    AcceptFaceTilesAndCheck(frame, faces, pairs, floor, &judge, &acceptance, det, &declined);
   } else if (!pairs.empty()) {
     ProposeEdgePairs(pairs, acceptance, &judge);
     acceptance.AcceptAll();

@@ -201,6 +201,14 @@ struct DetectorOptions {
   // turns it off).
   LayerPlaneOptions layer_plane;
   double floor_tolerance_m = 0.03;
+  // False: a face proposal lying on the floor found (every corner of its
+  // box at most 1.5 cm above the floor's plane, the deepest more than
+  // floor_tolerance_m + 2 cm beyond it) is not judged: refinement fits its
+  // face to the floor, so it would be declined as reaching into the floor
+  // (a noisy stereo floor's seam lines framed hundreds of faces a frame,
+  // a tenth of the pose stage; the same boxes on every evaluation set).
+  // True judges them as every other proposal.
+  bool judge_faces_on_floor = false;
   double floor_min_area_m2 = 0.25;
   // ... and it is the floor only when at most this share of the frame lies
   // beyond it (a lower layer's top or a pallet deck is the farthest plane

@@ -313,6 +313,32 @@ TEST(HeapScenesTest, FacesBetweenParallelEdgesFindMoreBricks) {
   EXPECT_LE(with.wrong + with.sunk, without.wrong + without.sunk);
 }
 
+// Face proposals lying on the floor found are not judged
+// (DetectorOptions::judge_faces_on_floor false): fewer hypotheses refined,
+// the same boxes.
+TEST(DetectorTest, FaceProposalsOnTheFloorAreNotJudgedAndChangeNoBox) {
+  const BoxDims dims = Model("brick");
+  int refined_without = 0, refined_with = 0;
+  for (uint32_t seed = 1; seed <= 3; ++seed) {
+    SCOPED_TRACE(::testing::Message() << "seed " << seed);
+    const RenderedScene out = Render(MakeHeapScene(dims, 6, seed), NoiseOptions{});
+    DetectorOptions options = Options(dims);
+    options.judge_faces_on_floor = true;
+    const absl::StatusOr<Detection> judged = DetectBoxes(out.cloud, options);
+    options.judge_faces_on_floor = false;
+    const absl::StatusOr<Detection> skipped = DetectBoxes(out.cloud, options);
+    ASSERT_TRUE(judged.ok()) << judged.status();
+    ASSERT_TRUE(skipped.ok()) << skipped.status();
+    ASSERT_EQ(skipped->boxes.size(), judged->boxes.size());
+    for (size_t i = 0; i < judged->boxes.size(); ++i) {
+      EXPECT_TRUE(skipped->boxes[i].camera_T_box.isApprox(judged->boxes[i].camera_T_box, 1e-9));
+    }
+    refined_with += judged->hypotheses.refined;
+    refined_without += skipped->hypotheses.refined;
+  }
+  EXPECT_LT(refined_without, refined_with);
+}
+
 TEST(DetectorTest, UnorganizedCloudOfAFrameFindsTheSameBoxes) {
   const BoxDims dims = Model("carton_s");
   const RenderedScene out = Render(MakeIsolatedScene(dims, 3, 1), NoiseOptions{});
