@@ -163,6 +163,30 @@ TEST(HypothesisJudgeTest, AHypothesisThroughTheFloorIsDeclinedWhenJudged) {
   }
 }
 
+// With the floor raised further (20 cm toward the camera, the carton lying
+// on the true floor reaching that far through it), no refinement within
+// its 5 cm and 12 degrees could bring it out: it is not refined at all, and
+// not listed as declined. Raised 10 cm (within reach: 3 cm of tolerance, 5
+// cm of shift and ~4 cm a corner moves as the box turns 12 degrees) it is
+// refined and then declined, as above.
+TEST(HypothesisJudgeTest, AHypothesisBeyondRefinementsReachThroughTheFloorIsNotRefined) {
+  const RenderedDepth b = RenderOneBox();
+  const Eigen::Isometry3d gt = b.out.boxes.at(0).camera_T_box;
+  DetectorOptions o;
+  o.box = kCartonS;
+  const Eigen::Vector3d n = b.out.floor_plane_camera.head<3>();
+  const Eigen::Vector3d on_floor = -b.out.floor_plane_camera.w() * n;
+  for (const double raised : {0.10, 0.20}) {
+    SCOPED_TRACE(::testing::Message() << "raised " << raised);
+    internal::HypothesisJudge judge(b.depth, o);
+    judge.SetFloor(n, on_floor + raised * n, 0.03);
+    judge.Propose(gt, 0, {});
+    EXPECT_TRUE(judge.Evaluate(1).empty());
+    EXPECT_EQ(judge.stats().refined, raised < 0.15 ? 1 : 0);
+    EXPECT_EQ(judge.declined().size(), raised < 0.15 ? 1u : 0u);
+  }
+}
+
 // A carton whose grasp face has one corner a few pixels past the image's
 // left edge, one long side under a taller box standing in front of it (read
 // occluded) and the other three free: judged as in view

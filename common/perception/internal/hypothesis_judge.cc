@@ -564,6 +564,7 @@ bool HypothesisJudge::EvaluateFrom(const Proposal& p, const Eigen::Isometry3d& s
   cand.box.num_corners = p.corners;
   cand.box.segments = p.segments;
   cand.box.from_face = p.from_face;
+  if (floor_ && BeyondRefinementOutOfFloor(start)) return false;
   EvidenceOptions gate = options_.evidence;
   gate.max_samples = std::min(gate.max_samples, gate.gate_max_samples);
   const BoxEvidence first = MeasureBox(depth_, cand.box.camera_T_box, options_.box, gate);
@@ -802,6 +803,23 @@ int HypothesisJudge::FindLike(const std::vector<Eigen::Isometry3d>& poses,
     }
   }
   return -1;
+}
+
+bool HypothesisJudge::BeyondRefinementOutOfFloor(const Eigen::Isometry3d& pose) const {
+  // A refinement within its limits moves the box's centre max_shift_m and
+  // turns it max_turn_deg about it: a corner at most that shift plus the
+  // chord of that turn on the box's half diagonal (and 5 mm to spare).
+  const BoxDims& d = options_.box;
+  const double half_diagonal = 0.5 * std::sqrt(d.l * d.l + d.b * d.b + d.h * d.h);
+  const double reach =
+      floor_->tolerance_m + options_.refinement.max_shift_m +
+      2.0 * half_diagonal * std::sin(options_.refinement.max_turn_deg * std::numbers::pi / 360.0) +
+      0.005;
+  double deepest = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& c : BoxCorners(pose, d)) {
+    deepest = std::min(deepest, floor_->normal.dot(c - floor_->centroid));
+  }
+  return -deepest > reach;
 }
 
 bool HypothesisJudge::Seen(const Eigen::Isometry3d& pose) const {

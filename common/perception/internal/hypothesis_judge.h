@@ -228,6 +228,12 @@ class HypothesisJudge {
   int OutOfViewSide(const Eigen::Isometry3d& pose, BoxFace grasp, const RefinementResult& ref,
                     bool in_view) const;
   bool Seen(const Eigen::Isometry3d& pose) const;
+  // With a floor set: `pose` reaches so far through it that no refinement
+  // within RefinementOptions::max_shift_m and max_turn_deg brings it back
+  // within the floor's tolerance. Such a hypothesis is not judged: it
+  // could only be declined (before session 31 it was refined first: 40 %
+  // of all refinements on detector_bench's clutter set).
+  bool BeyondRefinementOutOfFloor(const Eigen::Isometry3d& pose) const;
   // The index in `poses` of one like `pose` (within 1 cm, axes within
   // ~2.5 degrees up to the box's symmetries), or -1.
   int FindLike(const std::vector<Eigen::Isometry3d>& poses, const Eigen::Isometry3d& pose) const;
