@@ -999,14 +999,9 @@ class BoxAcceptance {
 // tiles into box faces, and a noisy one's seam lines frame hundreds.
 bool FaceOnTheFloor(const Eigen::Isometry3d& pose, const BoxDims& dims, const FloorPlane& floor,
                     double tolerance_m) {
-  double highest = -std::numeric_limits<double>::infinity();
-  double deepest = std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector3d& c : BoxCorners(pose, dims)) {
-    const double h = floor.normal.dot(c - floor.centroid);
-    highest = std::max(highest, h);
-    deepest = std::min(deepest, h);
-  }
-  return highest <= 0.015 && deepest < -(tolerance_m + 0.02);
+  const internal::CornerHeights h =
+      internal::CornerHeightsAbove(pose, dims, floor.normal, floor.centroid);
+  return h.highest <= 0.015 && h.lowest < -(tolerance_m + 0.02);
 }
 
 // The faces between parallel edges (edge_pair_faces.h), queued after the

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "absl/strings/str_cat.h"
 #include "common/perception/box_pose.h"
 #include "common/validation/range_check.h"
 

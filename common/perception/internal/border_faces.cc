@@ -70,16 +70,12 @@ int SideOutOfViewPinned(const DepthImage& depth, const Eigen::Isometry3d& camera
     // image): the view ends where it starts.
     int no_return_run = 0, no_return_decisive = 0;
     double last_return = 0.0;
-    bool left_view = false;
     for (double t = 0.5 * kStepM; t <= dims[here]; t += kStepM) {
       Eigen::Vector3d local = face_centre;
       local[here] = sign * (t - 0.5 * dims[here]);
       local[other] = w * dims[other];
       const Eigen::Vector3d q = camera_T_box * local;
-      if (!in_view(q)) {
-        left_view = true;
-        break;
-      }
+      if (!in_view(q)) break;
       last_in_view = t;
       const std::optional<double> h = HeightAt(depth, q, normal);
       const bool on_plane = h && !std::isnan(*h) && std::abs(*h) <= plane_tolerance_m;
@@ -100,7 +96,7 @@ int SideOutOfViewPinned(const DepthImage& depth, const Eigen::Isometry3d& camera
     }
     // The line must leave the view before the face's side: that side is
     // out of view, not unseen in it.
-    if (!left_view || last_in_view >= dims[here] - kStepM) return -1;
+    if (last_in_view >= dims[here] - kStepM) return -1;
     if (o.border_band_ends_view) {
       samples -= no_return_run;
       decisive -= no_return_decisive;

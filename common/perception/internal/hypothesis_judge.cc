@@ -217,13 +217,21 @@ double JudgeRefined(const BoxEvidence& ev, const RefinementResult& ref, const Bo
                     0.0, 1.0);
 }
 
+CornerHeights CornerHeightsAbove(const Eigen::Isometry3d& camera_T_box, const BoxDims& dims,
+                                 const Eigen::Vector3d& normal, const Eigen::Vector3d& on_plane) {
+  CornerHeights out{std::numeric_limits<double>::max(), -std::numeric_limits<double>::max()};
+  for (const Eigen::Vector3d& corner : BoxCorners(camera_T_box, dims)) {
+    const double h = normal.dot(corner - on_plane);
+    out.lowest = std::min(out.lowest, h);
+    out.highest = std::max(out.highest, h);
+  }
+  return out;
+}
+
 std::string ThroughFloor(const Eigen::Isometry3d& camera_T_box, const BoxDims& dims,
                          const Eigen::Vector3d& normal, const Eigen::Vector3d& on_plane,
                          double tolerance_m) {
-  double deepest = -std::numeric_limits<double>::max();
-  for (const Eigen::Vector3d& corner : BoxCorners(camera_T_box, dims)) {
-    deepest = std::max(deepest, -normal.dot(corner - on_plane));
-  }
+  const double deepest = -CornerHeightsAbove(camera_T_box, dims, normal, on_plane).lowest;
   if (deepest <= tolerance_m) return "";
   return absl::StrFormat(
       "the box would reach %.0f mm into the floor (a flat piece of something else of a face's "
@@ -815,11 +823,7 @@ bool HypothesisJudge::BeyondRefinementOutOfFloor(const Eigen::Isometry3d& pose) 
       floor_->tolerance_m + options_.refinement.max_shift_m +
       2.0 * half_diagonal * std::sin(options_.refinement.max_turn_deg * std::numbers::pi / 360.0) +
       0.005;
-  double deepest = std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector3d& c : BoxCorners(pose, d)) {
-    deepest = std::min(deepest, floor_->normal.dot(c - floor_->centroid));
-  }
-  return -deepest > reach;
+  return -CornerHeightsAbove(pose, d, floor_->normal, floor_->centroid).lowest > reach;
 }
 
 bool HypothesisJudge::Seen(const Eigen::Isometry3d& pose) const {

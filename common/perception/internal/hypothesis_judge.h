@@ -79,6 +79,15 @@ std::vector<Eigen::Isometry3d> TurnedAtMeasuredCorners(const Eigen::Isometry3d& 
                                                        const std::array<SideKind, 4>& sides,
                                                        const BoxDims& dims);
 
+// The lowest and the highest of a box's eight corners above a plane
+// (`normal` towards the camera, `on_plane` a point of it), metres: below
+// it where negative.
+struct CornerHeights {
+  double lowest, highest;
+};
+CornerHeights CornerHeightsAbove(const Eigen::Isometry3d& camera_T_box, const BoxDims& dims,
+                                 const Eigen::Vector3d& normal, const Eigen::Vector3d& on_plane);
+
 // Why a box cannot be there when it reaches more than tolerance_m through
 // a plane (the floor: `normal` towards the camera, `on_plane` a point of
 // it), its deepest corner measured away from the camera; "" when it does
