@@ -101,6 +101,9 @@ constexpr char kHelp[] =
     "                       0: every box keeps its own face's plane)\n"
     "  --layer_adopt DEG    ... and a face tilted up to DEG takes it when its pixels fit\n"
     "                       the plane about as well as their own (25)\n"
+    "  --layer_turn N       a box whose face touches N others on its plane that agree\n"
+    "                       on their in-plane turn takes the layer's turn (3; 0: every\n"
+    "                       box keeps its own)\n"
     "  --seam_colour SHARE  with a colour image, a groove in the depth is a seam only\n"
     "                       where an image line runs along SHARE of the side (0.5;\n"
     "                       0: the depth alone)\n"
@@ -230,6 +233,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("turned_proposals", &options.turned_proposals),
         args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
         args.SetDouble("layer_adopt", &options.layer_plane.adopt_angle_deg),
+        args.SetInt("layer_turn", &options.layer_turn.min_agreeing),
         args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
         args.SetDouble("sparse_seam", &options.refinement.sparse_seam_missing),
         args.SetDouble("eroded_faces", &options.faces.min_eroded_share),
@@ -370,6 +374,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "turned_proposals",
                                                        "layer_plane",
                                                        "layer_adopt",
+                                                       "layer_turn",
                                                        "seam_colour",
                                                        "sparse_seam",
                                                        "eroded_faces",

@@ -528,7 +528,7 @@ absl::Status DetectorOptions::Validate() const {
   for (absl::Status s :
        {edge_points.Validate(), segments.Validate(), clubbing.Validate(), pose.Validate(),
         refinement.Validate(), evidence.Validate(), acceptance.Validate(), faces.Validate(),
-        layer_plane.Validate(), edge_pairs.Validate()}) {
+        layer_plane.Validate(), layer_turn.Validate(), edge_pairs.Validate()}) {
     if (!s.ok()) return s;
   }
   if (empty_frame_window_cells < 0 || empty_frame_window_cells > 8) {
@@ -1112,6 +1112,7 @@ absl::Status JudgeAndKeep(const PreparedFrame& frame, const SegmentGroups& group
     acceptance.AcceptAll();
   }
   AlignToLayerPlanes(frame.depth, options.box, options.layer_plane, &det->boxes);
+  AlignToLayerTurns(options.box, options.layer_turn, &det->boxes);
   if (absl::Status s = cancel.Check("the judging of hypotheses"); !s.ok()) return s;
   if (options.score_in_view) {
     for (DetectedBox& box : det->boxes) {

@@ -17,6 +17,7 @@
 #include "common/perception/edge_segments.h"
 #include "common/perception/face_proposals.h"
 #include "common/perception/layer_plane.h"
+#include "common/perception/layer_turn.h"
 #include "common/perception/types.h"
 
 namespace cornerpose {
@@ -200,6 +201,10 @@ struct DetectorOptions {
   // plane fitted through all their faces (layer_plane.h; max_angle_deg 0
   // turns it off).
   LayerPlaneOptions layer_plane;
+  // ... and, where a box touches min_agreeing others on its plane that
+  // agree on their in-plane turn, the layer's turn (layer_turn.h;
+  // min_agreeing 0 turns it off).
+  LayerTurnOptions layer_turn;
   double floor_tolerance_m = 0.03;
   // False: a face proposal lying on the floor found (every corner of its
   // box at most 1.5 cm above the floor's plane, the deepest more than

@@ -7,29 +7,13 @@
 #include <numbers>
 #include <numeric>
 
+#include "common/perception/internal/grasp_face.h"
 #include "common/validation/range_check.h"
 
 namespace cornerpose {
 namespace {
 
-// A grasp face in the camera frame.
-struct Face {
-  Eigen::Vector3d c, n, a, b;  // centre, outward normal, in-plane axes (unit)
-  double half_a = 0.0, half_b = 0.0;
-};
-
-Face FaceOf(const DetectedBox& box, const BoxDims& dims) {
-  const int fi = static_cast<int>(box.grasp_face);
-  const int axis_n = fi / 2, axis_a = (axis_n + 1) % 3, axis_b = (axis_n + 2) % 3;
-  Face f;
-  f.c = box.grasp_centre_camera;
-  f.n = box.grasp_normal_camera.normalized();
-  f.a = box.camera_T_box.linear().col(axis_a);
-  f.b = box.camera_T_box.linear().col(axis_b);
-  f.half_a = dims[axis_a] / 2.0;
-  f.half_b = dims[axis_b] / 2.0;
-  return f;
-}
+using Face = internal::GraspFace;
 
 // The variance of the points (count, sums, sums of products) about their
 // best plane, and that plane's normal.
@@ -94,8 +78,7 @@ bool FitsPlane(const DepthImage& depth, const Face& f, const Eigen::Vector3d& no
 }
 
 bool Touch(const Face& a, const Face& b, const LayerPlaneOptions& o) {
-  return (a.c - b.c).norm() <=
-         o.touch_factor * (std::hypot(a.half_a, a.half_b) + std::hypot(b.half_a, b.half_b));
+  return internal::FacesTouch(a, b, o.touch_factor);
 }
 
 }  // namespace
@@ -119,15 +102,14 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
   const double cos_max = std::cos(options.max_angle_deg * std::numbers::pi / 180.0);
   std::vector<Face> faces;
   faces.reserve(n);
-  for (const DetectedBox& box : *boxes) faces.push_back(FaceOf(box, dims));
+  for (const DetectedBox& box : *boxes) faces.push_back(internal::GraspFaceOf(box, dims));
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       const Face &fi = faces[i], &fj = faces[j];
-      if (fi.n.dot(fj.n) < cos_max || !Touch(fi, fj, options) ||
-          std::abs((fj.c - fi.c).dot(fi.n)) > options.plane_tolerance_m ||
-          std::abs((fi.c - fj.c).dot(fj.n)) > options.plane_tolerance_m) {
+      if (!internal::FacesOnOnePlane(fi, fj, cos_max, options.plane_tolerance_m) ||
+          !Touch(fi, fj, options)) {
         continue;
       }
       parent[Root(parent, i)] = Root(parent, j);

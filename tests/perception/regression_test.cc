@@ -1248,5 +1248,25 @@ TEST(RegressionTest, ADisparityStripeOnADeckBoardIsNoSeam) {
   EXPECT_GE(det[1].boxes.size(), 10u);
 }
 
+// Was: in a ToF pallet layer of bricks, a neighbour proposed from a brick
+// of the layer came out turned 10.4 degrees in its plane (its turn read
+// from its seams alone) while its three touching neighbours lay within a
+// degree of the grid: a wrong box. Boxes of a layer now take its turn
+// (layer_turn.h). ToF brick s613 touching2_007, rendered in session 32
+// after the rules were set.
+TEST(RegressionTest, ABrickTurnedAgainstItsLayerTakesTheLayersTurn) {
+  const BoxDims brick{0.19, 0.09, 0.057};
+  const absl::StatusOr<RenderedScene> frame =
+      SensorFrame(SensorKind::kTimeOfFlight, true, "touching2", brick, 7, 613007);
+  ASSERT_TRUE(frame.ok()) << frame.status();
+  const RenderedScene& r = *frame;
+  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
+      RoundedToMillimetres(r), r, brick,
+      [](bool on, DetectorOptions* o) { o->layer_turn.min_agreeing = on ? 3 : 0; },
+      /*wrong_without=*/true);
+  // It changes poses, never which boxes are returned.
+  EXPECT_EQ(det[1].boxes.size(), det[0].boxes.size());
+}
+
 }  // namespace
 }  // namespace cornerpose::testing
