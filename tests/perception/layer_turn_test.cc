@@ -49,6 +49,7 @@ double TurnAgainstGrid(const DetectedBox& box, double grid_deg = 20.0) {
 // grid.
 std::vector<DetectedBox> Layer(const std::vector<double>& turns) {
   std::vector<DetectedBox> boxes;
+  boxes.reserve(turns.size());
   for (int k = 0; k < static_cast<int>(turns.size()); ++k) {
     boxes.push_back(Brick(k % 3, k / 3, turns[k]));
   }
