@@ -14,13 +14,9 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-// `x` brought into (-45, 45] degrees: a box's turn is known mod 90 (its
+// `deg` brought into [-45, 45] degrees: a box's turn is known mod 90 (its
 // face's sides are its axes either way).
-double Quarter(double deg) {
-  double r = std::fmod(deg + 45.0, 90.0);
-  if (r <= 0.0) r += 90.0;
-  return r - 45.0;
-}
+double Quarter(double deg) { return std::remainder(deg, 90.0); }
 
 // The turn about `n` that takes direction `from` onto `to` (both in the
 // plane of n), mod 90 degrees.
