@@ -88,6 +88,9 @@ constexpr char kHelp[] =
     "  --shifted_check BOOL a box seamed on both sides of an axis is taken out when\n"
     "                       its face shifted half its width is a box with more free\n"
     "                       sides (tape edges taken for seams; true)\n"
+    "  --paired_check BOOL  two boxes side by side whose faces together are another\n"
+    "                       face of the box are taken out when that one box is judged\n"
+    "                       a box too (flap seams taken for seams; true)\n"
     "  --retake_outranked BOOL a box a check took out no longer blocks the readings\n"
     "                       it outranked: they are judged again (true)\n"
     "  --turned_proposals BOOL  a hypothesis declined for a side on flat proposes its\n"
@@ -227,6 +230,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetBool("turned_hidden", &options.acceptance.turned_hidden_corner_to_check),
         args.SetBool("corner_tilt", &options.corner_tilt_onto_depth),
         args.SetBool("shifted_check", &options.shifted_check),
+        args.SetBool("paired_check", &options.paired_check),
         args.SetBool("retake_outranked", &options.retake_outranked),
         args.SetBool("unseen_sides", &options.acceptance.check_unseen_sides),
         args.SetDouble("unseen_longer", &options.acceptance.unseen_longer_see_through),
@@ -368,6 +372,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "turned_hidden",
                                                        "corner_tilt",
                                                        "shifted_check",
+                                                       "paired_check",
                                                        "retake_outranked",
                                                        "unseen_sides",
                                                        "unseen_longer",

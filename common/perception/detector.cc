@@ -19,6 +19,7 @@
 #include "common/perception/internal/box_overlap.h"
 #include "common/perception/internal/hypothesis_judge.h"
 #include "common/perception/internal/kept_neighbours.h"
+#include "common/perception/internal/paired_faces.h"
 #include "common/perception/internal/parallel.h"
 #include "common/perception/internal/view_share.h"
 #include "common/perception/neighbour_hypotheses.h"
@@ -362,6 +363,52 @@ bool CheckTurnedReadings(const internal::HypothesisJudge& judge, const DetectorO
   return TakeOutFlagged(checked, turned,
                         "its face reads as well turned a quarter at one of its corners (a line in "
                         "a face taken for a seam?): declined as ambiguous",
+                        boxes, readings, declined, cleared);
+}
+
+// DetectorOptions::paired_check: two boxes read side by side on one face
+// whose faces together are another face of the box (internal::
+// OneBoxForPair) are both taken out when that one box is judged a box too:
+// two readings of one surface the evidence cannot separate, the line
+// between them a carton's flap seam or tape. The one box's reading is then
+// left to the rounds after (the layers' tiles, retake_outranked). `cleared`
+// as for CheckTurnedReadings, a pair checked once.
+bool CheckPairedReadings(const internal::HypothesisJudge& judge, const DetectorOptions& options,
+                         std::vector<DetectedBox>* boxes, std::vector<KeptReading>* readings,
+                         std::vector<DeclinedCandidate>* declined,
+                         std::vector<Eigen::Isometry3d>* cleared) {
+  const int n = static_cast<int>(boxes->size());
+  struct Pair {
+    int i, j;
+    Eigen::Isometry3d one;
+  };
+  std::vector<Pair> pairs;
+  std::vector<uint8_t> checked(n, 0), paired(n, 0);
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      if (WasCleared(*cleared, (*boxes)[i].camera_T_box) &&
+          WasCleared(*cleared, (*boxes)[j].camera_T_box)) {
+        continue;
+      }
+      if (std::optional<Eigen::Isometry3d> one = internal::OneBoxForPair(
+              (*boxes)[i], (*boxes)[j], options.box, options.acceptance.extent_tolerance_m)) {
+        pairs.push_back({i, j, *one});
+        checked[i] = checked[j] = 1;
+      }
+    }
+  }
+  if (pairs.empty()) return false;
+  std::vector<uint8_t> one_is_a_box(pairs.size(), 0);
+  internal::ParallelForChunks(
+      static_cast<int>(pairs.size()), 1, options.num_threads,
+      [&](int, int p, int) { one_is_a_box[p] = judge.JudgeAlone(pairs[p].one).has_value(); });
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    if (one_is_a_box[p]) paired[pairs[p].i] = paired[pairs[p].j] = 1;
+  }
+  return TakeOutFlagged(checked, paired,
+                        "with the box beside it, its face is one face of a box on another side, "
+                        "judged a box too (a flap seam or tape taken for a seam?): declined as "
+                        "ambiguous",
                         boxes, readings, declined, cleared);
 }
 
@@ -1046,6 +1093,7 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
   acceptance->AcceptPairsAndTheirs();
   std::vector<Eigen::Isometry3d> cleared;          // CheckTurnedReadings
   std::vector<Eigen::Isometry3d> cleared_shifted;  // CheckShiftedReadings
+  std::vector<Eigen::Isometry3d> cleared_paired;   // CheckPairedReadings
   auto check = [&] {
     const bool layer_removed =
         options.faces.check_layer_tiling &&
@@ -1062,7 +1110,12 @@ void AcceptFaceTilesAndCheck(const PreparedFrame& f, const FaceProposals& faces,
         options.shifted_check &&
         CheckShiftedReadings(*judge, options, &det->boxes, acceptance->readings(), declined,
                              &cleared_shifted);
-    return layer_removed || level_removed || gaps_removed || turned_removed || shifted_removed;
+    const bool paired_removed =
+        options.paired_check &&
+        CheckPairedReadings(*judge, options, &det->boxes, acceptance->readings(), declined,
+                            &cleared_paired);
+    return layer_removed || level_removed || gaps_removed || turned_removed || shifted_removed ||
+           paired_removed;
   };
   for (int round = 0; round < 3 && check(); ++round) {
     for (const LayerTiles& layer : faces.layers) {

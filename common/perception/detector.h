@@ -260,6 +260,14 @@ struct DetectorOptions {
   // by the layer's edge, is the box. The retaken readings then get their
   // turn (retake_outranked).
   bool shifted_check = true;
+  // Two boxes read side by side on one face, their faces together another
+  // face of the box (internal::OneBoxForPair: a carton whose height is half
+  // its width has a top that its flap seam splits into two faces the size
+  // of its side), are both taken out when that one box is judged a box too:
+  // a stereo pallet of such cartons gave pairs of cartons on their side,
+  // the best box of its frame among them. The one box's reading then gets
+  // its turn (retake_outranked).
+  bool paired_check = true;
   // A hypothesis the judge accepted that a box kept before it overlapped
   // (it ranked below it) is judged again, and kept when it passes, once a
   // plausibility check (layer, level, gaps, turned readings) has

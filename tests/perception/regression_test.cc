@@ -597,6 +597,9 @@ TEST(RegressionTest, ACartonReadOnItsEndInsideAFlatOnesTopIsTakenOut) {
     // the frame as this rule was made on it (the groove rule alone changes
     // its boxes).
     options.refinement.seam_depth_per_rms = 0.0;
+    // The paired check (session 33) takes this carton out too: the level
+    // check alone is tested here.
+    options.paired_check = false;
     const absl::StatusOr<Detection> det = DetectBoxes(r.cloud, options);
     ASSERT_TRUE(det.ok()) << det.status();
     const int wrong = WrongBoxes(*det, r);
@@ -1266,6 +1269,31 @@ TEST(RegressionTest, ABrickTurnedAgainstItsLayerTakesTheLayersTurn) {
       /*wrong_without=*/true);
   // It changes poses, never which boxes are returned.
   EXPECT_EQ(det[1].boxes.size(), det[0].boxes.size());
+}
+
+// Was: on a stereo pallet of carton_flat (0.30 x 0.20 x 0.10: its height
+// half its width), the tops of two cartons, each split along its flap seam
+// into two faces the size of the carton's side, were returned as two pairs
+// of cartons on their side, 7 cm off and turned a quarter, the best box of
+// the frame among them. Such a pair, whose faces together are a carton's
+// top, is taken out when that one carton is judged a box too
+// (DetectorOptions::paired_check), and the cartons are found lying flat.
+// Stereo carton_flat s725 touching1_006, rendered in session 33 after the
+// rules were set.
+TEST(RegressionTest, TwoCartonsOnTheirSideThatAreOneCartonsTopAreTakenOut) {
+  const BoxDims carton_flat{0.30, 0.20, 0.10};
+  const absl::StatusOr<RenderedScene> frame =
+      SensorFrame(SensorKind::kStereo, true, "touching1", carton_flat, 6, 725006);
+  ASSERT_TRUE(frame.ok()) << frame.status();
+  const RenderedScene& r = *frame;
+  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
+      RoundedToMillimetres(r), r, carton_flat,
+      [](bool on, DetectorOptions* o) { o->paired_check = on; }, /*wrong_without=*/true);
+  // The cartons the pairs stood for are found instead.
+  const auto right = [&](const Detection& d) {
+    return static_cast<int>(d.boxes.size()) - WrongBoxes(d, r);
+  };
+  EXPECT_GT(right(det[1]), right(det[0]));
 }
 
 }  // namespace
