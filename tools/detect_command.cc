@@ -107,6 +107,8 @@ constexpr char kHelp[] =
     "  --layer_turn N       a box whose face touches N others on its plane that agree\n"
     "                       on their in-plane turn takes the layer's turn (3; 0: every\n"
     "                       box keeps its own)\n"
+    "  --floor_rest DEG     a box on the floor whose bottom is tilted into it by up to\n"
+    "                       DEG lies flat on it (12; 0: off)\n"
     "  --seam_colour SHARE  with a colour image, a groove in the depth is a seam only\n"
     "                       where an image line runs along SHARE of the side (0.5;\n"
     "                       0: the depth alone)\n"
@@ -238,6 +240,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetDouble("layer_plane", &options.layer_plane.max_angle_deg),
         args.SetDouble("layer_adopt", &options.layer_plane.adopt_angle_deg),
         args.SetInt("layer_turn", &options.layer_turn.min_agreeing),
+        args.SetDouble("floor_rest", &options.floor_rest.max_tilt_deg),
         args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
         args.SetDouble("sparse_seam", &options.refinement.sparse_seam_missing),
         args.SetDouble("eroded_faces", &options.faces.min_eroded_share),
@@ -380,6 +383,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "layer_plane",
                                                        "layer_adopt",
                                                        "layer_turn",
+                                                       "floor_rest",
                                                        "seam_colour",
                                                        "sparse_seam",
                                                        "eroded_faces",

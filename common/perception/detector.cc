@@ -572,10 +572,10 @@ absl::Status AcceptanceOptions::Validate() const {
 
 absl::Status DetectorOptions::Validate() const {
   if (absl::Status s = box.Validate(); !s.ok()) return s;
-  for (absl::Status s :
-       {edge_points.Validate(), segments.Validate(), clubbing.Validate(), pose.Validate(),
-        refinement.Validate(), evidence.Validate(), acceptance.Validate(), faces.Validate(),
-        layer_plane.Validate(), layer_turn.Validate(), edge_pairs.Validate()}) {
+  for (absl::Status s : {edge_points.Validate(), segments.Validate(), clubbing.Validate(),
+                         pose.Validate(), refinement.Validate(), evidence.Validate(),
+                         acceptance.Validate(), faces.Validate(), layer_plane.Validate(),
+                         layer_turn.Validate(), floor_rest.Validate(), edge_pairs.Validate()}) {
     if (!s.ok()) return s;
   }
   if (empty_frame_window_cells < 0 || empty_frame_window_cells > 8) {
@@ -1166,6 +1166,8 @@ absl::Status JudgeAndKeep(const PreparedFrame& frame, const SegmentGroups& group
   }
   AlignToLayerPlanes(frame.depth, options.box, options.layer_plane, &det->boxes);
   AlignToLayerTurns(options.box, options.layer_turn, &det->boxes);
+  if (floor)
+    RestOnFloor(floor->normal, floor->centroid, options.box, options.floor_rest, &det->boxes);
   if (absl::Status s = cancel.Check("the judging of hypotheses"); !s.ok()) return s;
   if (options.score_in_view) {
     for (DetectedBox& box : det->boxes) {

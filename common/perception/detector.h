@@ -16,6 +16,7 @@
 #include "common/perception/edge_points.h"
 #include "common/perception/edge_segments.h"
 #include "common/perception/face_proposals.h"
+#include "common/perception/floor_rest.h"
 #include "common/perception/layer_plane.h"
 #include "common/perception/layer_turn.h"
 #include "common/perception/types.h"
@@ -205,6 +206,10 @@ struct DetectorOptions {
   // agree on their in-plane turn, the layer's turn (layer_turn.h;
   // min_agreeing 0 turns it off).
   LayerTurnOptions layer_turn;
+  // Then a box resting on the floor (floor_check's floor), its bottom
+  // tilted into it by a face fit's error, lies flat on it (floor_rest.h;
+  // `floor_rest.max_tilt_deg` 0 turns it off).
+  FloorRestOptions floor_rest;
   double floor_tolerance_m = 0.03;
   // False: a face proposal lying on the floor found (every corner of its
   // box at most 1.5 cm above the floor's plane, the deepest more than
