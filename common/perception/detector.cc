@@ -1166,8 +1166,9 @@ absl::Status JudgeAndKeep(const PreparedFrame& frame, const SegmentGroups& group
   }
   AlignToLayerPlanes(frame.depth, options.box, options.layer_plane, &det->boxes);
   AlignToLayerTurns(options.box, options.layer_turn, &det->boxes);
-  if (floor)
+  if (floor) {
     RestOnFloor(floor->normal, floor->centroid, options.box, options.floor_rest, &det->boxes);
+  }
   if (absl::Status s = cancel.Check("the judging of hypotheses"); !s.ok()) return s;
   if (options.score_in_view) {
     for (DetectedBox& box : det->boxes) {
