@@ -105,8 +105,15 @@ struct FloorPlane {
   Eigen::Vector3d normal, centroid;  // the normal points at the camera
   double rms = 0.0;                  // its points' scatter about it, metres
 };
-std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptions& options,
-                                    const FaceProposals& faces) {
+// The farthest plane through planar patches together at least min_area
+// (FindFloor's first part). A patch's plane takes in every patch on it
+// (within 10 degrees and floor_tolerance_m) and is fitted through all their
+// points; `regather` times more, the plane so fitted takes in the patches
+// on it again: a noisy floor's pieces tilt their own planes by several
+// degrees, and measured from one piece the others a metre away lie
+// centimetres off it.
+std::optional<FloorPlane> FarthestPlane(const DepthImage& depth, const DetectorOptions& options,
+                                        const FaceProposals& faces, int regather) {
   const BoxDims& d = options.box;
   const double largest_face = std::max({d.l * d.b, d.l * d.h, d.b * d.h});
   const double min_area = std::max(options.floor_min_area_m2, 3.0 * largest_face);
@@ -119,59 +126,77 @@ std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptio
   const double cos_floor = std::cos(10.0 * M_PI / 180.0);
   for (const PlanarPatch& patch : faces.patches.patches) {
     // A noisy floor comes out of the segmentation in pieces (an active
-    // stereo camera at 2.5 m: none of them 0.36 m^2): a patch's plane takes
-    // in every patch on it, and is fitted through all their points.
+    // stereo camera at 2.5 m: none of them 0.36 m^2).
     if (area_of(patch) < 0.1 * min_area) continue;
-    double area = 0.0, count = 0.0;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-    for (const PlanarPatch& other : faces.patches.patches) {
-      if (&other != &patch && (other.normal.dot(patch.normal) < cos_floor ||
-                               std::abs(patch.normal.dot(other.centroid - patch.centroid)) >
-                                   options.floor_tolerance_m)) {
-        continue;
+    Eigen::Vector3d normal = patch.normal, centroid = patch.centroid;
+    double area = 0.0, rms = 0.0;
+    for (int round = 0; round <= regather; ++round) {
+      double count = 0.0;
+      area = 0.0;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+      for (const PlanarPatch& other : faces.patches.patches) {
+        if (!(round == 0 && &other == &patch) &&
+            (other.normal.dot(normal) < cos_floor ||
+             std::abs(normal.dot(other.centroid - centroid)) > options.floor_tolerance_m)) {
+          continue;
+        }
+        area += area_of(other);
+        for (const Eigen::Vector3d& q : other.points) {
+          sum += q;
+          outer += q * q.transpose();
+          count += 1.0;
+        }
       }
-      area += area_of(other);
-      for (const Eigen::Vector3d& q : other.points) {
-        sum += q;
-        outer += q * q.transpose();
-        count += 1.0;
-      }
+      if (count < 3.0) break;
+      centroid = sum / count;
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / count -
+                                                         centroid * centroid.transpose());
+      normal = eig.eigenvectors().col(0);
+      if (normal.dot(centroid) > 0.0) normal = -normal;
+      rms = std::sqrt(std::max(0.0, eig.eigenvalues()(0)));
     }
     if (area < min_area) continue;
-    const Eigen::Vector3d centroid = sum / count;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / count -
-                                                       centroid * centroid.transpose());
-    Eigen::Vector3d normal = eig.eigenvectors().col(0);
-    if (normal.dot(centroid) > 0.0) normal = -normal;
     // The normal points at the camera, so the plane is n.x = -distance.
     const double distance = -normal.dot(centroid);
     if (distance > floor_distance) {
       floor_distance = distance;
-      floor = FloorPlane{normal, centroid, std::sqrt(std::max(0.0, eig.eigenvalues()(0)))};
+      floor = FloorPlane{normal, centroid, rms};
     }
   }
-  if (!floor) return std::nullopt;
-  // It is the floor only when nothing lies beyond it: a lower layer's top
-  // or a pallet deck may be the farthest plane found while the floor itself
-  // (noisy, or cut up) is no patch. Beyond: past the tolerance, or past
-  // three times the floor's own scatter at the point's depth.
-  int seen = 0, beyond = 0;
-  for (int v = 0; v < depth.camera.height; v += 4) {
-    for (int u = 0; u < depth.camera.width; u += 4) {
-      const float z = depth.at(u, v);
-      if (std::isnan(z)) continue;
-      ++seen;
-      const Eigen::Vector3d p = z * PixelRay(depth.camera, u, v);
-      // Depth noise grows with z^2: the floor's scatter, measured about its
-      // centroid's depth, scaled to this point's.
-      const double zr = p.z() / floor->centroid.z();
-      const double limit = std::max(options.floor_tolerance_m, 3.0 * floor->rms * zr * zr);
-      beyond += -floor->normal.dot(p - floor->centroid) > limit;
-    }
-  }
-  if (seen == 0 || beyond > options.floor_max_beyond_share * seen) return std::nullopt;
   return floor;
+}
+
+// The floor: FarthestPlane, when nothing lies beyond it: a lower layer's
+// top or a pallet deck may be the farthest plane found while the floor
+// itself (noisy, or cut up) is no patch. Beyond: past the tolerance, or
+// past three times the floor's own scatter at the point's depth. When the
+// plane found so has too much beyond it, the pieces are gathered again
+// (FarthestPlane's regather, twice): a noisy stereo floor at 2-2.5 m
+// behind a brick pallet came out in pieces of 0.04-0.06 m^2 whose planes
+// gathered no floor, and the pallet's top was taken for it.
+std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptions& options,
+                                    const FaceProposals& faces) {
+  for (const int regather : {0, 2}) {
+    const std::optional<FloorPlane> floor = FarthestPlane(depth, options, faces, regather);
+    if (!floor) continue;
+    int seen = 0, beyond = 0;
+    for (int v = 0; v < depth.camera.height; v += 4) {
+      for (int u = 0; u < depth.camera.width; u += 4) {
+        const float z = depth.at(u, v);
+        if (std::isnan(z)) continue;
+        ++seen;
+        const Eigen::Vector3d p = z * PixelRay(depth.camera, u, v);
+        // Depth noise grows with z^2: the floor's scatter, measured about
+        // its centroid's depth, scaled to this point's.
+        const double zr = p.z() / floor->centroid.z();
+        const double limit = std::max(options.floor_tolerance_m, 3.0 * floor->rms * zr * zr);
+        beyond += -floor->normal.dot(p - floor->centroid) > limit;
+      }
+    }
+    if (seen > 0 && beyond <= options.floor_max_beyond_share * seen) return floor;
+  }
+  return std::nullopt;
 }
 
 // A box stands on something: amid the boxes of a layer found around it,
