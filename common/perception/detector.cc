@@ -171,7 +171,8 @@ std::optional<FloorPlane> FarthestPlane(const DepthImage& depth, const DetectorO
 // top or a pallet deck may be the farthest plane found while the floor
 // itself (noisy, or cut up) is no patch. Beyond: past the tolerance, or
 // past three times the floor's own scatter at the point's depth. When the
-// plane found so has too much beyond it, the pieces are gathered again
+// plane found so has too much beyond it (or none is found), the pieces are
+// gathered again
 // (FarthestPlane's regather, twice): a noisy stereo floor at 2-2.5 m
 // behind a brick pallet came out in pieces of 0.04-0.06 m^2 whose planes
 // gathered no floor, and the pallet's top was taken for it.
