@@ -121,32 +121,47 @@ std::optional<FloorPlane> FarthestPlane(const DepthImage& depth, const DetectorO
     const double cell_m = patch.centroid.z() / depth.camera.fx * faces.patches.step_px;
     return patch.points.size() * cell_m * cell_m;
   };
+  // Each patch's points summed once (count, sum, sum of outer products):
+  // every seed and round gathers patches, not points.
+  struct Moments {
+    double area = 0.0, count = 0.0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  };
+  const std::vector<PlanarPatch>& patches = faces.patches.patches;
+  std::vector<Moments> moments(patches.size());
+  for (size_t k = 0; k < patches.size(); ++k) {
+    moments[k].area = area_of(patches[k]);
+    for (const Eigen::Vector3d& q : patches[k].points) {
+      moments[k].sum += q;
+      moments[k].outer += q * q.transpose();
+      moments[k].count += 1.0;
+    }
+  }
   std::optional<FloorPlane> floor;
   double floor_distance = 0.0;
   const double cos_floor = std::cos(10.0 * M_PI / 180.0);
-  for (const PlanarPatch& patch : faces.patches.patches) {
+  for (size_t seed = 0; seed < patches.size(); ++seed) {
     // A noisy floor comes out of the segmentation in pieces (an active
     // stereo camera at 2.5 m: none of them 0.36 m^2).
-    if (area_of(patch) < 0.1 * min_area) continue;
-    Eigen::Vector3d normal = patch.normal, centroid = patch.centroid;
+    if (moments[seed].area < 0.1 * min_area) continue;
+    Eigen::Vector3d normal = patches[seed].normal, centroid = patches[seed].centroid;
     double area = 0.0, rms = 0.0;
     for (int round = 0; round <= regather; ++round) {
       double count = 0.0;
       area = 0.0;
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-      for (const PlanarPatch& other : faces.patches.patches) {
-        if (!(round == 0 && &other == &patch) &&
-            (other.normal.dot(normal) < cos_floor ||
-             std::abs(normal.dot(other.centroid - centroid)) > options.floor_tolerance_m)) {
+      for (size_t k = 0; k < patches.size(); ++k) {
+        if (!(round == 0 && k == seed) &&
+            (patches[k].normal.dot(normal) < cos_floor ||
+             std::abs(normal.dot(patches[k].centroid - centroid)) > options.floor_tolerance_m)) {
           continue;
         }
-        area += area_of(other);
-        for (const Eigen::Vector3d& q : other.points) {
-          sum += q;
-          outer += q * q.transpose();
-          count += 1.0;
-        }
+        area += moments[k].area;
+        sum += moments[k].sum;
+        outer += moments[k].outer;
+        count += moments[k].count;
       }
       if (count < 3.0) break;
       centroid = sum / count;
