@@ -226,7 +226,7 @@ void ProposeFromPatch(const DepthImage& image, const PlanarPatches& patches, siz
   };
   const PlanarPatch& patch = patches.patches[id];
   const double cell_m = patch.centroid.z() / image.camera.fx * patches.step_px;
-  const double area = patch.points.size() * cell_m * cell_m;
+  const double area = PatchArea(patch, image.camera.fx, patches.step_px);
   if (area < 0.5 * smallest_face) return;
   if (patch.normal.dot(-patch.centroid.normalized()) < cos_view) return;
   const PlaneRectangle rect = OutlineRectangle(patch);

@@ -66,6 +66,12 @@ struct PlanarPatches {
   }
 };
 
+// The patch's area on its plane, m^2: each cell covers (z step / fx)^2 of
+// an image-parallel plane, and 1 / cos(slant) times that of the patch's,
+// slanted to the ray through its centroid (a carton's side at 60 degrees
+// to the view is twice the area its cells count; clamped at 80 degrees).
+double PatchArea(const PlanarPatch& patch, double fx, int step_px);
+
 // With `merged_pieces` (may be null): the patches that merging
 // (merge_gap_cells) joined with others, each as it was before, with a label
 // map of their own (-1 outside them). Two boxes' faces on one plane with a
