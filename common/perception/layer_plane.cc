@@ -77,6 +77,21 @@ bool FitsPlane(const DepthImage& depth, const Face& f, const Eigen::Vector3d& no
   return about_rms <= o.max_rms_ratio * own_rms + 0.001;
 }
 
+// Whether face f, tilted against the plane (normal, point), has its centre
+// within `share` of the height its tilt lifts it to when it rests on the
+// plane by its lowest edge (LayerPlaneOptions::rest_share).
+bool InsidePlane(const Face& f, const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
+                 double share) {
+  if (share <= 0.0) return false;
+  const Eigen::Vector3d axis = f.n.cross(normal);  // the tilt's axis, |axis| = sin(tilt)
+  const double sin_tilt = axis.norm();
+  if (sin_tilt < 1e-6) return false;
+  // The face's half extent across that axis, in its plane.
+  const Eigen::Vector3d across = f.n.cross(axis / sin_tilt);
+  const double half = f.half_a * std::abs(across.dot(f.a)) + f.half_b * std::abs(across.dot(f.b));
+  return std::abs((f.c - point).dot(normal)) <= share * half * sin_tilt;
+}
+
 bool Touch(const Face& a, const Face& b, const LayerPlaneOptions& o) {
   return internal::FacesTouch(a, b, o.touch_factor);
 }
@@ -89,7 +104,8 @@ absl::Status LayerPlaneOptions::Validate() const {
                          CheckPositive("layer_plane.touch_factor", touch_factor, 2.0),
                          CheckRange("layer_plane.side_margin_m", side_margin_m, 0.0, 0.1),
                          CheckRange("layer_plane.max_rms_ratio", max_rms_ratio, 1.0, 10.0),
-                         CheckRange("layer_plane.adopt_angle_deg", adopt_angle_deg, 0.0, 45.0)}) {
+                         CheckRange("layer_plane.adopt_angle_deg", adopt_angle_deg, 0.0, 45.0),
+                         CheckRange("layer_plane.rest_share", rest_share, 0.0, 1.0)}) {
     if (!s.ok()) return s;
   }
   return absl::OkStatus();
@@ -128,10 +144,11 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
   auto toward = [&](int i, const Eigen::Vector3d& normal) -> Eigen::Vector3d {
     return normal.dot(faces[i].n) < 0.0 ? -normal : normal;
   };
-  auto take_plane = [&](int i, const Eigen::Vector3d& normal) {
+  auto take_plane = [&](int i, const Eigen::Vector3d& normal, bool rests_in_plane = false) {
     const Eigen::Vector3d to = toward(i, normal);
     const double cos_turn = to.dot(faces[i].n);
-    if (cos_turn < cos_adopt || (cos_turn < cos_max && !FitsPlane(depth, faces[i], to, options))) {
+    if (cos_turn < cos_adopt ||
+        (cos_turn < cos_max && !rests_in_plane && !FitsPlane(depth, faces[i], to, options))) {
       return false;
     }
     chosen[i] = to;
@@ -221,7 +238,10 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
             std::abs((faces[j].c - layer.centroid).dot(layer.normal)) > options.plane_tolerance_m) {
           continue;
         }
-        if (take_plane(j, layer.normal)) break;
+        if (take_plane(j, layer.normal,
+                       InsidePlane(faces[j], layer.normal, layer.centroid, options.rest_share))) {
+          break;
+        }
       }
     }
   }

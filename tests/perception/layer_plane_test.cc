@@ -200,12 +200,15 @@ TEST(LayerPlaneTest, ASmallGroupTiltedByItsNoiseTakesTheBiggerGroupsPlane) {
 
 TEST(LayerPlaneTest, ABrickReallyTiltedBesideTheLayerKeepsItsPlane) {
   // A brick beside the layer, turned 15 degrees about its long axis (one
-  // long side 2.3 cm higher than the other), its face centre on the
-  // layer's plane: its pixels do not fit that plane.
+  // long side 2.3 cm higher than the other) and resting on the floor by its
+  // lower long edge: its face centre 1 cm over the layer's plane (on it,
+  // within plane_tolerance_m, but as high as the tilt lifts it), and its
+  // pixels do not fit that plane.
   SceneBox askew = Flat(2 * kBrick.l, 0.0);
-  askew.world_T_box.linear() =
-      Eigen::AngleAxisd(15.0 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitX())
-          .toRotationMatrix();
+  const double tilt = 15.0 * std::numbers::pi / 180.0;
+  askew.world_T_box.linear() = Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  askew.world_T_box.translation().z() =
+      kBrick.b / 2.0 * std::sin(tilt) + kBrick.h / 2.0 * std::cos(tilt);
   const Layer l = RenderLayer({askew});
   ASSERT_EQ(l.rendered.boxes.size(), 7u);
   std::vector<DetectedBox> boxes;
@@ -213,6 +216,48 @@ TEST(LayerPlaneTest, ABrickReallyTiltedBesideTheLayerKeepsItsPlane) {
   const DetectedBox before = boxes[6];
   EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 6);
   EXPECT_TRUE(boxes[6].camera_T_box.isApprox(before.camera_T_box));
+}
+
+TEST(LayerPlaneTest, AFaceTiltedByNoiseWithItsCentreInTheLayerTakesItsPlane) {
+  // A brick flat beside the layer whose pixels a blob of correlated noise
+  // tilts by 13 degrees about its long axis (an active-stereo camera at
+  // 2 m), returned so tilted: its pixels fit their own plane, not the
+  // layer's, but its face centre lies on the layer's plane, where a brick
+  // so tilted would have a long side 1 cm inside the layer
+  // (LayerPlaneOptions::rest_share): it takes the layer's plane.
+  Layer l = RenderLayer({Flat(2 * kBrick.l, 0.0)});
+  ASSERT_EQ(l.rendered.boxes.size(), 7u);
+  const GroundTruthBox& g = l.rendered.boxes[6];
+  const Eigen::Vector3d n = TrueNormal(g);
+  const Eigen::Vector3d across = g.camera_T_box.linear().col(1);  // the 9 cm axis
+  const Eigen::Vector3d centre = g.camera_T_box.translation();
+  const double slope = std::tan(13.0 * std::numbers::pi / 180.0);
+  for (size_t i = 0; i < l.depth.z.size(); ++i) {
+    float& z = l.depth.z[i];
+    if (!(z > 0.0f) || l.rendered.instance[i] != 7) continue;
+    const Eigen::Vector3d p = l.rendered.cloud.xyz[i].cast<double>();
+    z += static_cast<float>(slope * (p - centre).dot(across) * -n.z());
+  }
+  auto returned = [&] {
+    std::vector<DetectedBox> boxes;
+    for (int i = 0; i < 6; ++i) boxes.push_back(Returned(l.rendered.boxes[i], 1.0, 60.0 * i));
+    // Tilted as its pixels are: about the long axis, toward the 9 cm one.
+    boxes.push_back(Returned(g, 13.0, 0.0));
+    if (Deg(std::acos(std::min(1.0, boxes[6].grasp_normal_camera.dot(n)))) < 12.0) {
+      ADD_FAILURE() << "not tilted past max_angle_deg";
+    }
+    return boxes;
+  };
+  std::vector<DetectedBox> boxes = returned();
+  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 7);
+  EXPECT_LT(Deg(std::acos(std::min(1.0, boxes[6].grasp_normal_camera.dot(n)))), 0.5);
+  // Asking for the fit always: it keeps its tilt.
+  LayerPlaneOptions fit_only;
+  fit_only.rest_share = 0.0;
+  std::vector<DetectedBox> again = returned();
+  const DetectedBox tilted = again[6];
+  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, fit_only, &again), 6);
+  EXPECT_TRUE(again[6].camera_T_box.isApprox(tilted.camera_T_box));
 }
 
 TEST(LayerPlaneTest, ABoxOnTopOfTheLayerIsNotOnItsPlane) {
@@ -280,6 +325,9 @@ TEST(LayerPlaneTest, ValidateNamesTheField) {
   o = LayerPlaneOptions();
   o.adopt_angle_deg = 50.0;
   EXPECT_NE(o.Validate().message().find("layer_plane.adopt_angle_deg"), std::string::npos);
+  o = LayerPlaneOptions();
+  o.rest_share = 1.5;
+  EXPECT_NE(o.Validate().message().find("layer_plane.rest_share"), std::string::npos);
 }
 
 }  // namespace
