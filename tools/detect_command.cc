@@ -108,7 +108,7 @@ constexpr char kHelp[] =
     "                       on their in-plane turn takes the layer's turn (3; 0: every\n"
     "                       box keeps its own)\n"
     "  --floor_rest DEG     a box on the floor whose bottom is tilted into it by up to\n"
-    "                       DEG lies flat on it (12; 0: off)\n"
+    "                       DEG lies flat on it (15; 0: off)\n"
     "  --seam_colour SHARE  with a colour image, a groove in the depth is a seam only\n"
     "                       where an image line runs along SHARE of the side (0.5;\n"
     "                       0: the depth alone)\n"

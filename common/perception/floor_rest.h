@@ -23,9 +23,11 @@ namespace cornerpose {
 
 struct FloorRestOptions {
   // A box is turned only when its bottom is tilted against the floor by at
-  // most this (more is not a fit's error). Degrees, [0, 30]; 0 turns the
-  // rule off.
-  double max_tilt_deg = 12.0;
+  // most this (more is not a fit's error). 12 in session 33: a stereo brick
+  // in a heap, its 9 cm face fitted 12.5 degrees off on the noise, its
+  // bottom in the floor, kept its pose. Degrees, [0, 30]; 0 turns the rule
+  // off.
+  double max_tilt_deg = 15.0;
   // ... and by more than this (less is within the fit's noise).
   // Degrees, [0, 30].
   double min_tilt_deg = 1.0;

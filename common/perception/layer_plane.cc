@@ -62,9 +62,10 @@ void AddFacePixels(const DepthImage& depth, const Face& f, const LayerPlaneOptio
 
 // Whether a face's pixels lie about a plane of normal `normal` (through
 // their own centroid) within max_rms_ratio (plus 1 mm) of their rms about
-// their own best plane: a tilt its noise allows.
+// their own best plane: a tilt its noise allows. (`o` gives the pixels'
+// side margin.)
 bool FitsPlane(const DepthImage& depth, const Face& f, const Eigen::Vector3d& normal,
-               const LayerPlaneOptions& o) {
+               const LayerPlaneOptions& o, double max_rms_ratio) {
   double c = 0.0;
   Eigen::Vector3d s1 = Eigen::Vector3d::Zero();
   Eigen::Matrix3d s2 = Eigen::Matrix3d::Zero();
@@ -74,7 +75,7 @@ bool FitsPlane(const DepthImage& depth, const Face& f, const Eigen::Vector3d& no
   const Eigen::Vector3d mean = s1 / c;
   const Eigen::Matrix3d cov = s2 / c - mean * mean.transpose();
   const double about_rms = std::sqrt(std::max(0.0, normal.dot(cov * normal)));
-  return about_rms <= o.max_rms_ratio * own_rms + 0.001;
+  return about_rms <= max_rms_ratio * own_rms + 0.001;
 }
 
 // Whether face f, tilted against the plane (normal, point), has its centre
@@ -99,13 +100,15 @@ bool Touch(const Face& a, const Face& b, const LayerPlaneOptions& o) {
 }  // namespace
 
 absl::Status LayerPlaneOptions::Validate() const {
-  for (absl::Status s : {CheckRange("layer_plane.max_angle_deg", max_angle_deg, 0.0, 30.0),
-                         CheckPositive("layer_plane.plane_tolerance_m", plane_tolerance_m, 0.1),
-                         CheckPositive("layer_plane.touch_factor", touch_factor, 2.0),
-                         CheckRange("layer_plane.side_margin_m", side_margin_m, 0.0, 0.1),
-                         CheckRange("layer_plane.max_rms_ratio", max_rms_ratio, 1.0, 10.0),
-                         CheckRange("layer_plane.adopt_angle_deg", adopt_angle_deg, 0.0, 45.0),
-                         CheckRange("layer_plane.rest_share", rest_share, 0.0, 1.0)}) {
+  for (absl::Status s :
+       {CheckRange("layer_plane.max_angle_deg", max_angle_deg, 0.0, 30.0),
+        CheckPositive("layer_plane.plane_tolerance_m", plane_tolerance_m, 0.1),
+        CheckPositive("layer_plane.touch_factor", touch_factor, 2.0),
+        CheckRange("layer_plane.side_margin_m", side_margin_m, 0.0, 0.1),
+        CheckRange("layer_plane.max_rms_ratio", max_rms_ratio, 1.0, 10.0),
+        CheckRange("layer_plane.adopt_angle_deg", adopt_angle_deg, 0.0, 45.0),
+        CheckRange("layer_plane.rest_share", rest_share, 0.0, 1.0),
+        CheckRange("layer_plane.rest_max_rms_ratio", rest_max_rms_ratio, 1.0, 10.0)}) {
     if (!s.ok()) return s;
   }
   return absl::OkStatus();
@@ -148,7 +151,9 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
     const Eigen::Vector3d to = toward(i, normal);
     const double cos_turn = to.dot(faces[i].n);
     if (cos_turn < cos_adopt ||
-        (cos_turn < cos_max && !rests_in_plane && !FitsPlane(depth, faces[i], to, options))) {
+        (cos_turn < cos_max &&
+         !FitsPlane(depth, faces[i], to, options,
+                    rests_in_plane ? options.rest_max_rms_ratio : options.max_rms_ratio))) {
       return false;
     }
     chosen[i] = to;
@@ -212,7 +217,8 @@ int AlignToLayerPlanes(const DepthImage& depth, const BoxDims& dims,
       });
       const bool fits = std::all_of(s_layer.members.begin(), s_layer.members.end(), [&](int j) {
         const Eigen::Vector3d to = toward(j, b_layer.normal);
-        return to.dot(faces[j].n) >= cos_adopt && FitsPlane(depth, faces[j], to, options);
+        return to.dot(faces[j].n) >= cos_adopt &&
+               FitsPlane(depth, faces[j], to, options, options.max_rms_ratio);
       });
       if (!touches || !fits) continue;
       for (int j : s_layer.members) {

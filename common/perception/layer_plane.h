@@ -49,15 +49,19 @@ struct LayerPlaneOptions {
   // tilted that far does not fit the layer's plane. Degrees, [0, 45];
   // at most max_angle_deg turns this off.
   double adopt_angle_deg = 25.0;
-  // ... and takes it without that fit when its centre lies within this
-  // share of the height its tilt would lift it to above the plane: resting
-  // on the layer by one edge, so tilted, its centre would sit that high;
-  // lower, part of it would lie inside the layer, which only the noise
-  // can put it (a brick at 2 m on an active-stereo camera, its centre 2 mm
-  // off the layer's plane and its face tilted 13 degrees by a blob of
-  // correlated noise that its own pixels fit 1.5 times better than the
-  // layer's plane). Unitless, [0, 1]; 0 always asks for the fit.
+  // ... and takes it with a looser fit (rest_max_rms_ratio) when its centre
+  // lies within this share of the height its tilt would lift it to above
+  // the plane: resting on the layer by one edge, so tilted, its centre
+  // would sit that high; lower, part of it would lie inside the layer,
+  // which the noise can put it (a brick at 2 m on an active-stereo camera,
+  // its centre 2 mm off the layer's plane and its face tilted 13 degrees
+  // by a blob of correlated noise that its own pixels fit 1.5 times better
+  // than the layer's plane), or a gap beside the layer (a heap's carton
+  // tilted 15 degrees into one: its pixels fit the layer's plane five
+  // times worse). Unitless, [0, 1]; 0 always asks for max_rms_ratio.
   double rest_share = 0.5;
+  // Unitless, [1, 10].
+  double rest_max_rms_ratio = 2.0;
   // A group beside a bigger one, its faces' centres on the bigger one's
   // plane, takes that plane when its normal is within adopt_angle_deg of
   // it and every one of its faces fits it as above: three bricks under one

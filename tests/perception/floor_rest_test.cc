@@ -47,7 +47,7 @@ int Rest(std::vector<DetectedBox>* boxes, const FloorRestOptions& options = {}) 
 }
 
 TEST(FloorRestTest, ABrickTiltedIntoTheFloorLiesFlatOnIt) {
-  for (const double tilt : {6.0, 8.0, -11.0}) {
+  for (const double tilt : {6.0, 8.0, -11.0, 13.5}) {
     std::vector<DetectedBox> boxes{Brick(tilt)};
     const Eigen::Vector3d centre = boxes[0].grasp_centre_camera;
     ASSERT_EQ(Rest(&boxes), 1) << tilt;

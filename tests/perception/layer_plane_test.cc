@@ -218,40 +218,62 @@ TEST(LayerPlaneTest, ABrickReallyTiltedBesideTheLayerKeepsItsPlane) {
   EXPECT_TRUE(boxes[6].camera_T_box.isApprox(before.camera_T_box));
 }
 
+TEST(LayerPlaneTest, ABrickTiltedIntoAGapBesideTheLayerKeepsItsPlane) {
+  // As above, but turned about its own centre: its face centre lies on the
+  // layer's plane and one long side 1 cm below it (into a gap beside the
+  // layer, as a heap's box tilts). Its pixels fit their own plane exactly
+  // and the layer's not at all: it keeps its tilt, however low it lies.
+  SceneBox askew = Flat(2 * kBrick.l, 0.0);
+  askew.world_T_box.linear() =
+      Eigen::AngleAxisd(15.0 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitX())
+          .toRotationMatrix();
+  const Layer l = RenderLayer({askew});
+  ASSERT_EQ(l.rendered.boxes.size(), 7u);
+  std::vector<DetectedBox> boxes;
+  for (int i = 0; i < 7; ++i) boxes.push_back(Returned(l.rendered.boxes[i], 0.0, 0.0));
+  const DetectedBox before = boxes[6];
+  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 6);
+  EXPECT_TRUE(boxes[6].camera_T_box.isApprox(before.camera_T_box));
+}
+
 TEST(LayerPlaneTest, AFaceTiltedByNoiseWithItsCentreInTheLayerTakesItsPlane) {
-  // A brick flat beside the layer whose pixels a blob of correlated noise
-  // tilts by 13 degrees about its long axis (an active-stereo camera at
-  // 2 m), returned so tilted: its pixels fit their own plane, not the
-  // layer's, but its face centre lies on the layer's plane, where a brick
-  // so tilted would have a long side 1 cm inside the layer
-  // (LayerPlaneOptions::rest_share): it takes the layer's plane.
+  // Depth noise of 5 mm everywhere and, over a brick lying flat beside the
+  // layer, a blob of correlated noise that tilts its pixels by 20 degrees
+  // about its long axis (an active-stereo camera at 2 m); returned so
+  // tilted. Its pixels fit the layer's plane 1.8 times worse than their own
+  // (past max_rms_ratio), but its face centre lies on the layer's plane,
+  // where a brick so tilted would have a long side 1.5 cm inside the layer
+  // (LayerPlaneOptions::rest_share): within rest_max_rms_ratio, it takes
+  // the layer's plane.
   Layer l = RenderLayer({Flat(2 * kBrick.l, 0.0)});
   ASSERT_EQ(l.rendered.boxes.size(), 7u);
   const GroundTruthBox& g = l.rendered.boxes[6];
   const Eigen::Vector3d n = TrueNormal(g);
   const Eigen::Vector3d across = g.camera_T_box.linear().col(1);  // the 9 cm axis
   const Eigen::Vector3d centre = g.camera_T_box.translation();
-  const double slope = std::tan(13.0 * std::numbers::pi / 180.0);
+  const double slope = std::tan(20.0 * std::numbers::pi / 180.0);
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, 0.005f);
   for (size_t i = 0; i < l.depth.z.size(); ++i) {
     float& z = l.depth.z[i];
-    if (!(z > 0.0f) || l.rendered.instance[i] != 7) continue;
-    const Eigen::Vector3d p = l.rendered.cloud.xyz[i].cast<double>();
-    z += static_cast<float>(slope * (p - centre).dot(across) * -n.z());
+    if (!(z > 0.0f)) continue;
+    if (l.rendered.instance[i] == 7) {
+      const Eigen::Vector3d p = l.rendered.cloud.xyz[i].cast<double>();
+      z += static_cast<float>(slope * (p - centre).dot(across) * -n.z());
+    }
+    z += noise(rng);
   }
   auto returned = [&] {
     std::vector<DetectedBox> boxes;
     for (int i = 0; i < 6; ++i) boxes.push_back(Returned(l.rendered.boxes[i], 1.0, 60.0 * i));
     // Tilted as its pixels are: about the long axis, toward the 9 cm one.
-    boxes.push_back(Returned(g, 13.0, 0.0));
-    if (Deg(std::acos(std::min(1.0, boxes[6].grasp_normal_camera.dot(n)))) < 12.0) {
-      ADD_FAILURE() << "not tilted past max_angle_deg";
-    }
+    boxes.push_back(Returned(g, -20.0, 0.0));
     return boxes;
   };
   std::vector<DetectedBox> boxes = returned();
   EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 7);
-  EXPECT_LT(Deg(std::acos(std::min(1.0, boxes[6].grasp_normal_camera.dot(n)))), 0.5);
-  // Asking for the fit always: it keeps its tilt.
+  EXPECT_LT(Deg(std::acos(std::min(1.0, boxes[6].grasp_normal_camera.dot(n)))), 1.0);
+  // Asking for max_rms_ratio always: it keeps its tilt.
   LayerPlaneOptions fit_only;
   fit_only.rest_share = 0.0;
   std::vector<DetectedBox> again = returned();
@@ -328,6 +350,9 @@ TEST(LayerPlaneTest, ValidateNamesTheField) {
   o = LayerPlaneOptions();
   o.rest_share = 1.5;
   EXPECT_NE(o.Validate().message().find("layer_plane.rest_share"), std::string::npos);
+  o = LayerPlaneOptions();
+  o.rest_max_rms_ratio = 0.5;
+  EXPECT_NE(o.Validate().message().find("layer_plane.rest_max_rms_ratio"), std::string::npos);
 }
 
 }  // namespace
