@@ -10,8 +10,10 @@
 // that plane's normal, turned about its own face centre: its in-plane turn
 // and position stay its own. A face tilted further (up to adopt_angle_deg)
 // that touches the group takes the plane when its pixels fit it about as
-// well as their own; a box alone, or one whose pixels do not fit the plane
-// (a carton sitting askew on the layer), keeps its own fit.
+// well as their own (or, its centre so low on the plane that so tilted it
+// would lie partly inside the layer, within a looser fit: rest_share); a
+// box alone, or one whose pixels do not fit the plane (a carton sitting
+// askew on the layer), keeps its own fit.
 #pragma once
 
 #include <vector>
@@ -60,7 +62,8 @@ struct LayerPlaneOptions {
   // tilted 15 degrees into one: its pixels fit the layer's plane five
   // times worse). Unitless, [0, 1]; 0 always asks for max_rms_ratio.
   double rest_share = 0.5;
-  // Unitless, [1, 10].
+  // The looser fit: its pixels about the layer's plane within this times
+  // (plus 1 mm) their rms about their own. Unitless, [1, 10].
   double rest_max_rms_ratio = 2.0;
   // A group beside a bigger one, its faces' centres on the bigger one's
   // plane, takes that plane when its normal is within adopt_angle_deg of

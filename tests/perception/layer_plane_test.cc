@@ -198,6 +198,19 @@ TEST(LayerPlaneTest, ASmallGroupTiltedByItsNoiseTakesTheBiggerGroupsPlane) {
   }
 }
 
+// Renders the layer with `askew` beside it, returns every box at its true
+// pose, and expects the layer's six to take its plane and `askew` to keep
+// its own.
+void ExpectKeepsItsPlane(const SceneBox& askew) {
+  const Layer l = RenderLayer({askew});
+  ASSERT_EQ(l.rendered.boxes.size(), 7u);
+  std::vector<DetectedBox> boxes;
+  for (int i = 0; i < 7; ++i) boxes.push_back(Returned(l.rendered.boxes[i], 0.0, 0.0));
+  const DetectedBox before = boxes[6];
+  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 6);
+  EXPECT_TRUE(boxes[6].camera_T_box.isApprox(before.camera_T_box));
+}
+
 TEST(LayerPlaneTest, ABrickReallyTiltedBesideTheLayerKeepsItsPlane) {
   // A brick beside the layer, turned 15 degrees about its long axis (one
   // long side 2.3 cm higher than the other) and resting on the floor by its
@@ -209,13 +222,7 @@ TEST(LayerPlaneTest, ABrickReallyTiltedBesideTheLayerKeepsItsPlane) {
   askew.world_T_box.linear() = Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX()).toRotationMatrix();
   askew.world_T_box.translation().z() =
       kBrick.b / 2.0 * std::sin(tilt) + kBrick.h / 2.0 * std::cos(tilt);
-  const Layer l = RenderLayer({askew});
-  ASSERT_EQ(l.rendered.boxes.size(), 7u);
-  std::vector<DetectedBox> boxes;
-  for (int i = 0; i < 7; ++i) boxes.push_back(Returned(l.rendered.boxes[i], 0.0, 0.0));
-  const DetectedBox before = boxes[6];
-  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 6);
-  EXPECT_TRUE(boxes[6].camera_T_box.isApprox(before.camera_T_box));
+  ExpectKeepsItsPlane(askew);
 }
 
 TEST(LayerPlaneTest, ABrickTiltedIntoAGapBesideTheLayerKeepsItsPlane) {
@@ -227,13 +234,7 @@ TEST(LayerPlaneTest, ABrickTiltedIntoAGapBesideTheLayerKeepsItsPlane) {
   askew.world_T_box.linear() =
       Eigen::AngleAxisd(15.0 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitX())
           .toRotationMatrix();
-  const Layer l = RenderLayer({askew});
-  ASSERT_EQ(l.rendered.boxes.size(), 7u);
-  std::vector<DetectedBox> boxes;
-  for (int i = 0; i < 7; ++i) boxes.push_back(Returned(l.rendered.boxes[i], 0.0, 0.0));
-  const DetectedBox before = boxes[6];
-  EXPECT_EQ(AlignToLayerPlanes(l.depth, kBrick, LayerPlaneOptions(), &boxes), 6);
-  EXPECT_TRUE(boxes[6].camera_T_box.isApprox(before.camera_T_box));
+  ExpectKeepsItsPlane(askew);
 }
 
 TEST(LayerPlaneTest, AFaceTiltedByNoiseWithItsCentreInTheLayerTakesItsPlane) {
