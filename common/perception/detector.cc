@@ -118,8 +118,7 @@ std::optional<FloorPlane> FarthestPlane(const DepthImage& depth, const DetectorO
   const double largest_face = std::max({d.l * d.b, d.l * d.h, d.b * d.h});
   const double min_area = std::max(options.floor_min_area_m2, 3.0 * largest_face);
   auto area_of = [&](const PlanarPatch& patch) {
-    const double cell_m = patch.centroid.z() / depth.camera.fx * faces.patches.step_px;
-    return patch.points.size() * cell_m * cell_m;
+    return PatchCellsArea(patch, depth.camera.fx, faces.patches.step_px);
   };
   // Each patch's points summed once (count, sum, sum of outer products):
   // every seed and round gathers patches, not points.

@@ -231,9 +231,8 @@ void ProposeFromPatch(const DepthImage& image, const PlanarPatches& patches, siz
   // cuts keeps the count of its cells, the stricter test (with its slanted
   // area, a wooden cabinet panel at the top of a real YCB-V frame, 60
   // degrees to the view, proposed a box-sized face that the judge took).
-  const double area = patch.touches_border
-                          ? static_cast<double>(patch.points.size()) * cell_m * cell_m
-                          : PatchArea(patch, image.camera.fx, patches.step_px);
+  const double area = patch.touches_border ? PatchCellsArea(patch, image.camera.fx, patches.step_px)
+                                           : PatchArea(patch, image.camera.fx, patches.step_px);
   if (area < 0.5 * smallest_face) return;
   if (patch.normal.dot(-patch.centroid.normalized()) < cos_view) return;
   const PlaneRectangle rect = OutlineRectangle(patch);

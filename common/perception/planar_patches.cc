@@ -192,12 +192,16 @@ absl::Status PlanarPatchOptions::Validate() const {
   return absl::OkStatus();
 }
 
-double PatchArea(const PlanarPatch& patch, double fx, int step_px) {
+double PatchCellsArea(const PlanarPatch& patch, double fx, int step_px) {
   const double cell_m = patch.centroid.z() / fx * step_px;
+  return static_cast<double>(patch.points.size()) * cell_m * cell_m;
+}
+
+double PatchArea(const PlanarPatch& patch, double fx, int step_px) {
   const double norm = patch.centroid.norm();
   const double cos_slant = norm > 0.0 ? std::abs(patch.normal.dot(patch.centroid)) / norm : 1.0;
   constexpr double kMinCos = 0.17364817766693033;  // cos(80 degrees)
-  return static_cast<double>(patch.points.size()) * cell_m * cell_m / std::max(cos_slant, kMinCos);
+  return PatchCellsArea(patch, fx, step_px) / std::max(cos_slant, kMinCos);
 }
 
 PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOptions& o,

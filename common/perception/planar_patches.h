@@ -66,8 +66,11 @@ struct PlanarPatches {
   }
 };
 
-// The patch's area on its plane, m^2: each cell covers (z step / fx)^2 of
-// an image-parallel plane, and 1 / cos(slant) times that of the patch's,
+// What the patch's cells cover of a plane facing the camera at its
+// centroid's depth, m^2: (z step / fx)^2 each.
+double PatchCellsArea(const PlanarPatch& patch, double fx, int step_px);
+
+// The patch's area on its plane, m^2: 1 / cos(slant) times its cells' area,
 // slanted to the ray through its centroid (a carton's side at 60 degrees
 // to the view is twice the area its cells count; clamped at 80 degrees).
 double PatchArea(const PlanarPatch& patch, double fx, int step_px);
