@@ -113,12 +113,12 @@ struct FloorPlane {
 // degrees, and measured from one piece the others a metre away lie
 // centimetres off it.
 std::optional<FloorPlane> FarthestPlane(const DepthImage& depth, const DetectorOptions& options,
-                                        const FaceProposals& faces, int regather) {
+                                        const PlanarPatches& found, int regather) {
   const BoxDims& d = options.box;
   const double largest_face = std::max({d.l * d.b, d.l * d.h, d.b * d.h});
   const double min_area = std::max(options.floor_min_area_m2, 3.0 * largest_face);
   auto area_of = [&](const PlanarPatch& patch) {
-    return PatchCellsArea(patch, depth.camera.fx, faces.patches.step_px);
+    return PatchCellsArea(patch, depth.camera.fx, found.step_px);
   };
   // Each patch's points summed once (count, sum, sum of outer products):
   // every seed and round gathers patches, not points.
@@ -127,7 +127,7 @@ std::optional<FloorPlane> FarthestPlane(const DepthImage& depth, const DetectorO
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
   };
-  const std::vector<PlanarPatch>& patches = faces.patches.patches;
+  const std::vector<PlanarPatch>& patches = found.patches;
   std::vector<Moments> moments(patches.size());
   for (size_t k = 0; k < patches.size(); ++k) {
     moments[k].area = area_of(patches[k]);
@@ -191,9 +191,9 @@ std::optional<FloorPlane> FarthestPlane(const DepthImage& depth, const DetectorO
 // behind a brick pallet came out in pieces of 0.04-0.06 m^2 whose planes
 // gathered no floor, and the pallet's top was taken for it.
 std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptions& options,
-                                    const FaceProposals& faces) {
+                                    const PlanarPatches& patches) {
   for (const int regather : {0, 2}) {
-    const std::optional<FloorPlane> floor = FarthestPlane(depth, options, faces, regather);
+    const std::optional<FloorPlane> floor = FarthestPlane(depth, options, patches, regather);
     if (!floor) continue;
     int seen = 0, beyond = 0;
     for (int v = 0; v < depth.camera.height; v += 4) {
@@ -212,6 +212,33 @@ std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptio
     if (seen > 0 && beyond <= options.floor_max_beyond_share * seen) return floor;
   }
   return std::nullopt;
+}
+
+// The frame's face proposals and its floor (FindFloor, with floor_check),
+// found from the same patches before any of them proposes: the patches on
+// the floor's plane propose nothing (unless judge_faces_on_floor), as each
+// face on it would be a box reaching into the floor, never judged. Within
+// half the box's smallest side of that plane (or the floor's tolerance, if
+// less) a patch cannot be the top of a box lying on it.
+FaceProposals FindFacesAndFloor(const DepthImage& depth, const DetectorOptions& options,
+                                const FaceProposalOptions& face_options, const CancelToken* cancel,
+                                internal::SharedLoops* helpers, std::optional<FloorPlane>* floor) {
+  floor->reset();
+  if (!options.floor_check) {
+    return ProposeFromFaces(depth, options.box, face_options, cancel, helpers);
+  }
+  const double thinnest = std::min({options.box.l, options.box.b, options.box.h});
+  return ProposeFromFaces(
+      depth, options.box, face_options, cancel, helpers,
+      [&](const PlanarPatches& patches) -> std::optional<ExcludedPlane> {
+        *floor = FindFloor(depth, options, patches);
+        if (!*floor || options.judge_faces_on_floor) return std::nullopt;
+        ExcludedPlane plane;
+        plane.normal = (*floor)->normal;
+        plane.point = (*floor)->centroid;
+        plane.max_distance_m = std::min(options.floor_tolerance_m, 0.5 * thinnest);
+        return plane;
+      });
 }
 
 // A box stands on something: amid the boxes of a layer found around it,
@@ -789,7 +816,8 @@ absl::Status PrepareFrame(const PointCloud& input, const DetectorOptions& option
 // Phase 2: the edge points, their segments and corners (the paper's
 // stages), and beside them the planar patches and their tilings.
 absl::Status FindEdgesAndFaces(const PreparedFrame& f, const CancelToken& cancel, Detection* det,
-                               SegmentGroups* groups, FaceProposals* faces) {
+                               SegmentGroups* groups, FaceProposals* faces,
+                               std::optional<FloorPlane>* floor) {
   const DetectorOptions& options = f.options;
   Clock::time_point t0 = Clock::now();
   absl::StatusOr<EdgePoints> edges =
@@ -814,8 +842,8 @@ absl::Status FindEdgesAndFaces(const PreparedFrame& f, const CancelToken& cancel
     if (options.face_proposals) {
       faces_thread = std::jthread([&] {
         const Clock::time_point t_faces = Clock::now();
-        *faces = ProposeFromFaces(f.depth, options.box, options.faces, &cancel,
-                                  share ? &face_loops : nullptr);
+        *faces = FindFacesAndFloor(f.depth, options, options.faces, &cancel,
+                                   share ? &face_loops : nullptr, floor);
         det->timings.faces_ms = MsSince(t_faces);
         face_loops.Close();
         if (share) shared.Help();
@@ -1178,19 +1206,18 @@ namespace {
 // and kept, into det (its boxes, hypotheses, declined candidates and
 // poses_ms).
 absl::Status JudgeAndKeep(const PreparedFrame& frame, const SegmentGroups& groups,
-                          const FaceProposals& faces, const CancelToken& cancel, Detection* det) {
+                          const FaceProposals& faces, const std::optional<FloorPlane>& floor,
+                          const CancelToken& cancel, Detection* det) {
   const DetectorOptions& options = frame.options;
   const Clock::time_point t0 = Clock::now();
   internal::HypothesisJudge judge(frame.depth, options, &cancel);
-  // The floor (DetectorOptions::floor_check) is known before any box is
-  // judged: a reading with a corner more than floor_tolerance_m through it
-  // (a pallet's deck board read as a box reaches its own height into the
-  // floor, and so does a box of another size read as this one on end) is
-  // declined when judged, so it cannot outrank (and block) another reading
-  // of the same face. Every box kept is judged so: no check after.
-  const std::optional<FloorPlane> floor = options.face_proposals && options.floor_check
-                                              ? FindFloor(frame.depth, options, faces)
-                                              : std::nullopt;
+  // The floor (DetectorOptions::floor_check; FindFacesAndFloor) is known
+  // before any box is judged: a reading with a corner more than
+  // floor_tolerance_m through it (a pallet's deck board read as a box
+  // reaches its own height into the floor, and so does a box of another
+  // size read as this one on end) is declined when judged, so it cannot
+  // outrank (and block) another reading of the same face. Every box kept is
+  // judged so: no check after.
   if (floor) judge.SetFloor(floor->normal, floor->centroid, options.floor_tolerance_m);
   BoxAcceptance acceptance(options, cancel, &judge, det);
   ProposeFromCorners(*det, groups, options, &judge);
@@ -1242,10 +1269,11 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
 
   SegmentGroups groups;
   FaceProposals faces;
-  if (absl::Status s = FindEdgesAndFaces(frame, cancel, &det, &groups, &faces); !s.ok()) {
+  std::optional<FloorPlane> floor;
+  if (absl::Status s = FindEdgesAndFaces(frame, cancel, &det, &groups, &faces, &floor); !s.ok()) {
     return s;
   }
-  if (absl::Status s = JudgeAndKeep(frame, groups, faces, cancel, &det); !s.ok()) return s;
+  if (absl::Status s = JudgeAndKeep(frame, groups, faces, floor, cancel, &det); !s.ok()) return s;
 
   // Nothing found: the planar patches once more with a wider normal window
   // (DetectorOptions::empty_frame_window_cells), unless the caller chose
@@ -1257,10 +1285,13 @@ absl::StatusOr<Detection> DetectBoxes(const PointCloud& input, const DetectorOpt
     FaceProposalOptions wider = options.faces;
     wider.patches.window_cells = options.empty_frame_window_cells;
     const Clock::time_point t_faces = Clock::now();
-    const FaceProposals wider_faces = ProposeFromFaces(frame.depth, options.box, wider, &cancel);
+    std::optional<FloorPlane> wider_floor;
+    const FaceProposals wider_faces =
+        FindFacesAndFloor(frame.depth, options, wider, &cancel, nullptr, &wider_floor);
     det.timings.faces_ms += MsSince(t_faces);
     if (absl::Status s = cancel.Check("the planar patches"); !s.ok()) return s;
-    if (absl::Status s = JudgeAndKeep(frame, groups, wider_faces, cancel, &det); !s.ok()) {
+    if (absl::Status s = JudgeAndKeep(frame, groups, wider_faces, wider_floor, cancel, &det);
+        !s.ok()) {
       return s;
     }
   }

@@ -217,7 +217,11 @@ struct DetectorOptions {
   // face to the floor, so it would be declined as reaching into the floor
   // (a noisy stereo floor's seam lines framed hundreds of faces a frame,
   // a tenth of the pose stage; the same boxes on every evaluation set).
-  // True judges them as every other proposal.
+  // The planar patches on the floor's plane (centroid within the floor's
+  // tolerance or half the box's thinnest side, normal within 10 degrees)
+  // then propose nothing at all: the floor is found from the patches first
+  // (splitting its border-cut outline along seams was most of the faces
+  // stage). True judges them as every other proposal.
   bool judge_faces_on_floor = false;
   double floor_min_area_m2 = 0.25;
   // ... and it is the floor only when at most this share of the frame lies

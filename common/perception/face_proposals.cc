@@ -401,14 +401,21 @@ void ProposeFromPatch(const DepthImage& image, const PlanarPatches& patches, siz
 
 }  // namespace
 
+bool ExcludedPlane::Holds(const PlanarPatch& patch) const {
+  return patch.normal.dot(normal) >= std::cos(max_angle_deg * std::numbers::pi / 180.0) &&
+         std::abs(normal.dot(patch.centroid - point)) <= max_distance_m;
+}
+
 FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
                                const FaceProposalOptions& o, const CancelToken* cancel,
-                               internal::SharedLoops* helpers) {
+                               internal::SharedLoops* helpers,
+                               const ExcludedPlaneFinder& exclude) {
   FaceProposals out;
   PlanarPatches pieces;
   out.patches = SegmentPlanarPatches(image, o.patches, o.propose_merged_pieces ? &pieces : nullptr);
   const PlanarPatches& patches = out.patches;
   out.num_patches = static_cast<int>(patches.patches.size());
+  const std::optional<ExcludedPlane> excluded = exclude ? exclude(patches) : std::nullopt;
   // Patch by patch, then piece by piece, each into its own slot (with
   // helpers, in any order on any thread), gathered in that order: the same
   // proposals either way.
@@ -416,6 +423,8 @@ FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
   std::vector<PatchProposals> per_patch(n + pieces.patches.size());
   auto propose = [&](int begin, int end) {
     for (int id = begin; id < end && !StopRequested(cancel); ++id) {
+      const PlanarPatch& patch = id < n ? patches.patches[id] : pieces.patches[id - n];
+      if (excluded && excluded->Holds(patch)) continue;
       if (id < n) {
         ProposeFromPatch(image, patches, id, dims, o, &per_patch[id]);
       } else {

@@ -279,6 +279,55 @@ TEST(FaceProposalsTest, ALayerOfTouchingBoxesWithNoSeamsTilesIntoItsBoxes) {
   ExpectTiles(f, p.poses, 0.30, 0.20);
 }
 
+// The detector finds the floor from the patches and passes its plane: the
+// patches on it propose nothing (no poses, layer or declined tiling), the
+// others as before.
+TEST(FaceProposalsTest, PatchesOnTheExcludedPlaneProposeNothing) {
+  LayerFrame f;  // 3 x 2 cartons at kTop on a floor at kFloor
+  f.Render();
+  const FaceProposals all = ProposeFromFaces(f.image, kCarton, FaceProposalOptions{});
+  ASSERT_EQ(all.poses.size(), 6u);
+  ASSERT_FALSE(all.layers.empty());
+  auto plane_at = [](double z) {
+    ExcludedPlane plane;
+    plane.normal = -Eigen::Vector3d::UnitZ();
+    plane.point = Eigen::Vector3d(0.0, 0.0, z);
+    plane.max_distance_m = 0.01;
+    return plane;
+  };
+  int calls = 0;
+  const FaceProposals no_layer = ProposeFromFaces(
+      f.image, kCarton, FaceProposalOptions{}, nullptr, nullptr,
+      [&](const PlanarPatches& patches) -> std::optional<ExcludedPlane> {
+        ++calls;
+        EXPECT_EQ(patches.patches.size(), all.patches.patches.size());
+        return plane_at(kTop);
+      });
+  EXPECT_EQ(calls, 1);
+  EXPECT_TRUE(no_layer.poses.empty());
+  EXPECT_TRUE(no_layer.layers.empty());
+  EXPECT_EQ(no_layer.num_patches, all.num_patches);  // found, not proposed from
+  // 2 cm off the layer's plane, or tilted 15 degrees: not on it.
+  for (const ExcludedPlane& beside :
+       {plane_at(kTop + 0.02), [&] {
+          ExcludedPlane p = plane_at(kTop);
+          p.normal = Eigen::AngleAxisd(15.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()) * p.normal;
+          return p;
+        }()}) {
+    const FaceProposals kept =
+        ProposeFromFaces(f.image, kCarton, FaceProposalOptions{}, nullptr, nullptr,
+                         [&](const PlanarPatches&) { return std::optional(beside); });
+    EXPECT_EQ(kept.poses.size(), 6u);
+  }
+  const FaceProposals no_floor =
+      ProposeFromFaces(f.image, kCarton, FaceProposalOptions{}, nullptr, nullptr,
+                       [&](const PlanarPatches&) { return std::optional(plane_at(kFloor)); });
+  ASSERT_EQ(no_floor.poses.size(), all.poses.size());
+  for (size_t i = 0; i < all.poses.size(); ++i) {
+    EXPECT_TRUE(no_floor.poses[i].isApprox(all.poses[i], 0.0)) << i;
+  }
+}
+
 // With helpers (internal::SharedLoops, as the detector's segments thread
 // helps when done), the patches are tiled on two threads: the proposals,
 // layers and declined tilings are those of one thread, in the same order.
