@@ -193,7 +193,7 @@ std::optional<FloorPlane> FarthestPlane(const DepthImage& depth, const DetectorO
 std::optional<FloorPlane> FindFloor(const DepthImage& depth, const DetectorOptions& options,
                                     const PlanarPatches& patches) {
   for (const int regather : {0, 2}) {
-    const std::optional<FloorPlane> floor = FarthestPlane(depth, options, patches, regather);
+    std::optional<FloorPlane> floor = FarthestPlane(depth, options, patches, regather);
     if (!floor) continue;
     int seen = 0, beyond = 0;
     for (int v = 0; v < depth.camera.height; v += 4) {
