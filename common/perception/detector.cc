@@ -228,17 +228,17 @@ FaceProposals FindFacesAndFloor(const DepthImage& depth, const DetectorOptions& 
     return ProposeFromFaces(depth, options.box, face_options, cancel, helpers);
   }
   const double thinnest = std::min({options.box.l, options.box.b, options.box.h});
-  return ProposeFromFaces(
-      depth, options.box, face_options, cancel, helpers,
-      [&](const PlanarPatches& patches) -> std::optional<ExcludedPlane> {
-        *floor = FindFloor(depth, options, patches);
-        if (!*floor || options.judge_faces_on_floor) return std::nullopt;
-        ExcludedPlane plane;
-        plane.normal = (*floor)->normal;
-        plane.point = (*floor)->centroid;
-        plane.max_distance_m = std::min(options.floor_tolerance_m, 0.5 * thinnest);
-        return plane;
-      });
+  return ProposeFromFaces(depth, options.box, face_options, cancel, helpers,
+                          [&](const PlanarPatches& patches) -> std::optional<ExcludedPlane> {
+                            *floor = FindFloor(depth, options, patches);
+                            if (!*floor || options.judge_faces_on_floor) return std::nullopt;
+                            ExcludedPlane plane;
+                            plane.normal = (*floor)->normal;
+                            plane.point = (*floor)->centroid;
+                            plane.max_distance_m =
+                                std::min(options.floor_tolerance_m, 0.5 * thinnest);
+                            return plane;
+                          });
 }
 
 // A box stands on something: amid the boxes of a layer found around it,

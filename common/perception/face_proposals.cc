@@ -408,8 +408,7 @@ bool ExcludedPlane::Holds(const PlanarPatch& patch) const {
 
 FaceProposals ProposeFromFaces(const DepthImage& image, const BoxDims& dims,
                                const FaceProposalOptions& o, const CancelToken* cancel,
-                               internal::SharedLoops* helpers,
-                               const ExcludedPlaneFinder& exclude) {
+                               internal::SharedLoops* helpers, const ExcludedPlaneFinder& exclude) {
   FaceProposals out;
   PlanarPatches pieces;
   out.patches = SegmentPlanarPatches(image, o.patches, o.propose_merged_pieces ? &pieces : nullptr);

@@ -13,6 +13,10 @@ namespace cornerpose {
 namespace {
 
 // Running sums of points for a plane fit.
+// A piece holding this share of its merged patch's cells is not listed
+// among the merged pieces (MergeCoplanarPatches).
+constexpr double kWholePieceShare = 0.95;
+
 struct Moments {
   double n = 0;
   Eigen::Vector3d s = Eigen::Vector3d::Zero();
@@ -129,7 +133,14 @@ void MergeCoplanarPatches(const PlanarPatchOptions& o, const Tolerance& toleranc
     pieces->label.assign(out->label.size(), -1);
     std::vector<int> piece_id(n, -1);
     for (int i = 0; i < n; ++i) {
-      if (members[Root(parent, i)] == 1) continue;
+      const int root = Root(parent, i);
+      if (members[root] == 1) continue;
+      // Nearly all of its patch (crumbs merged into it): its outline, and
+      // so its faces, are the patch's.
+      if (static_cast<double>(out->patches[i].points.size()) >=
+          kWholePieceShare * moments[root].n) {
+        continue;
+      }
       piece_id[i] = static_cast<int>(pieces->patches.size());
       pieces->patches.push_back(out->patches[i]);
     }

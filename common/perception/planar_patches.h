@@ -79,7 +79,9 @@ double PatchArea(const PlanarPatch& patch, double fx, int step_px);
 // (merge_gap_cells) joined with others, each as it was before, with a label
 // map of their own (-1 outside them). Two boxes' faces on one plane with a
 // shadow between them merge into a patch that is neither; their pieces
-// still are.
+// still are. A piece holding 95 % or more of its merged patch's cells (a
+// layer's top with crumbs merged into it) is left out: its outline, and so
+// its faces, are the patch's.
 PlanarPatches SegmentPlanarPatches(const DepthImage& depth, const PlanarPatchOptions& options,
                                    PlanarPatches* merged_pieces = nullptr);
 

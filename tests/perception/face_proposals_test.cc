@@ -296,13 +296,13 @@ TEST(FaceProposalsTest, PatchesOnTheExcludedPlaneProposeNothing) {
     return plane;
   };
   int calls = 0;
-  const FaceProposals no_layer = ProposeFromFaces(
-      f.image, kCarton, FaceProposalOptions{}, nullptr, nullptr,
-      [&](const PlanarPatches& patches) -> std::optional<ExcludedPlane> {
-        ++calls;
-        EXPECT_EQ(patches.patches.size(), all.patches.patches.size());
-        return plane_at(kTop);
-      });
+  const FaceProposals no_layer =
+      ProposeFromFaces(f.image, kCarton, FaceProposalOptions{}, nullptr, nullptr,
+                       [&](const PlanarPatches& patches) -> std::optional<ExcludedPlane> {
+                         ++calls;
+                         EXPECT_EQ(patches.patches.size(), all.patches.patches.size());
+                         return plane_at(kTop);
+                       });
   EXPECT_EQ(calls, 1);
   EXPECT_TRUE(no_layer.poses.empty());
   EXPECT_TRUE(no_layer.layers.empty());
@@ -420,6 +420,48 @@ TEST(FaceProposalsTest, FacesMergedAcrossAGapAreProposedFromTheirPieces) {
   const FaceProposals without = ProposeFromFaces(image, kCarton, o);
   EXPECT_FALSE(proposes(without, tops[1]));
   EXPECT_LT(without.poses.size(), with.poses.size());
+}
+
+// A big flat top (0.8 x 0.6 m) and a small square (12 cm) on its plane, a
+// shadow between them, as in the test above: merging joins them, and the
+// piece holding nearly all of the merged patch (95 % of its cells) is not
+// listed among the merged pieces (its outline, and so its faces, are the
+// patch's); the small one is.
+TEST(FaceProposalsTest, APieceHoldingNearlyAllOfItsMergedPatchIsNotAPiece) {
+  auto in_big = [](double x, double y, double m) {
+    return std::abs(x + 0.25) <= 0.4 + m && std::abs(y) <= 0.3 + m;
+  };
+  auto in_small = [](double x, double y, double m) {
+    const double c = std::cos(25.0 * M_PI / 180), s = std::sin(25.0 * M_PI / 180);
+    const double dx = x - 0.24, dy = y - 0.05;
+    return std::abs(c * dx + s * dy) <= 0.06 + m && std::abs(-s * dx + c * dy) <= 0.06 + m;
+  };
+  DepthImage image;
+  const CameraIntrinsics& k = image.camera;
+  image.z.assign(static_cast<size_t>(k.width) * k.height, 0.0f);
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const Eigen::Vector3d ray = PixelRay(k, u, v);
+      const double x = ray.x() * kTop, y = ray.y() * kTop;
+      const bool on_top = in_big(x, y, 0.0) || in_small(x, y, 0.0);
+      const bool shadow = in_big(x, y, 0.03) || in_small(x, y, 0.03);
+      image.z[static_cast<size_t>(v) * k.width + u] = on_top ? static_cast<float>(kTop)
+                                                      : shadow
+                                                          ? std::numeric_limits<float>::quiet_NaN()
+                                                          : static_cast<float>(kFloor);
+    }
+  }
+  PlanarPatches pieces;
+  const PlanarPatches merged = SegmentPlanarPatches(image, FaceProposalOptions{}.patches, &pieces);
+  auto at = [&](const PlanarPatches& p, double x, double y) {
+    const Eigen::Vector2d px = Project(k, Eigen::Vector3d(x, y, kTop));
+    return p.PatchAt(static_cast<int>(px.x()), static_cast<int>(px.y()));
+  };
+  ASSERT_GE(at(merged, -0.25, 0.0), 0);
+  ASSERT_EQ(at(merged, -0.25, 0.0), at(merged, 0.24, 0.05)) << "the two are not merged";
+  ASSERT_EQ(pieces.patches.size(), 1u);  // the small one alone
+  EXPECT_EQ(at(pieces, -0.25, 0.0), -1);
+  EXPECT_EQ(at(pieces, 0.24, 0.05), 0);
 }
 
 // A carton top whose rim the segmentation took in (here the outline is
