@@ -37,9 +37,11 @@ struct EdgeSegmentOptions {
   // Points within this multiple of ransac_threshold_m of a segment are
   // removed with it (edge bands are wider than the RANSAC tube). Unitless, >= 1.
   double removal_scale = 1.5;
-  // Stop after this many segments, or this many rejected runs in a row.
+  // Stop after this many segments, or this many rejected runs in a row
+  // (40 before session 35: on 62 clutter frames no segment came after more
+  // than 11 in a row, and the 94 evaluation sets' boxes are the same).
   int max_segments = 200;
-  int max_failures = 40;
+  int max_failures = 20;
   // Seed of the random generator: the same input and seed give the same output.
   uint32_t seed = 42;
   // Threads for the RANSAC iterations (the result does not depend on it).
