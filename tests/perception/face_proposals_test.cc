@@ -355,6 +355,43 @@ TEST(FaceProposalsTest, PatchesSharedWithAHelperProposeTheSame) {
   EXPECT_EQ(shared.declined.size(), alone.declined.size());
 }
 
+// A rectangular top on the plane at kTop: centre, turn about the optical
+// axis, half sizes. Metres, degrees.
+struct Top {
+  Eigen::Vector2d centre;
+  double yaw_deg;
+  double half_l = kCarton.l / 2, half_b = kCarton.b / 2;
+  bool Contains(double x, double y, double margin = 0.0) const {
+    const double c = std::cos(yaw_deg * M_PI / 180), s = std::sin(yaw_deg * M_PI / 180);
+    const double dx = x - centre.x(), dy = y - centre.y();
+    return std::abs(c * dx + s * dy) <= half_l + margin &&
+           std::abs(-s * dx + c * dy) <= half_b + margin;
+  }
+};
+
+// Exact depth of tops on one plane at kTop, each with a shadow 3 cm wide
+// around it (a Kinect's: no return), the floor at kFloor beyond.
+DepthImage TopsWithShadows(const std::vector<Top>& tops) {
+  DepthImage image;
+  const CameraIntrinsics& k = image.camera;
+  image.z.assign(static_cast<size_t>(k.width) * k.height, 0.0f);
+  auto any = [&](double x, double y, double margin) {
+    return std::any_of(tops.begin(), tops.end(),
+                       [&](const Top& t) { return t.Contains(x, y, margin); });
+  };
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const Eigen::Vector3d ray = PixelRay(k, u, v);
+      const double x = ray.x() * kTop, y = ray.y() * kTop;
+      image.z[static_cast<size_t>(v) * k.width + u] = any(x, y, 0.0) ? static_cast<float>(kTop)
+                                                      : any(x, y, 0.03)
+                                                          ? std::numeric_limits<float>::quiet_NaN()
+                                                          : static_cast<float>(kFloor);
+    }
+  }
+  return image;
+}
+
 // Two carton tops on one plane, 1.2 m below the camera, a shadow of a few
 // pixels between them, one turned 25 degrees: merging (merge_gap_cells)
 // joins them into one patch whose outline tiles as neither. The pieces
@@ -362,33 +399,9 @@ TEST(FaceProposalsTest, PatchesSharedWithAHelperProposeTheSame) {
 // propose_merged_pieces); the merged patch alone proposes none of the
 // turned one.
 TEST(FaceProposalsTest, FacesMergedAcrossAGapAreProposedFromTheirPieces) {
-  struct Top {
-    Eigen::Vector2d centre;
-    double yaw_deg;
-    bool Contains(double x, double y, double margin = 0.0) const {
-      const double c = std::cos(yaw_deg * M_PI / 180), s = std::sin(yaw_deg * M_PI / 180);
-      const double dx = x - centre.x(), dy = y - centre.y();
-      return std::abs(c * dx + s * dy) <= kCarton.l / 2 + margin &&
-             std::abs(-s * dx + c * dy) <= kCarton.b / 2 + margin;
-    }
-  };
   const Top tops[2] = {{{-0.17, 0.0}, 0.0}, {{0.17, 0.06}, 25.0}};
-  DepthImage image;
+  const DepthImage image = TopsWithShadows({tops[0], tops[1]});
   const CameraIntrinsics& k = image.camera;
-  image.z.assign(static_cast<size_t>(k.width) * k.height, 0.0f);
-  for (int v = 0; v < k.height; ++v) {
-    for (int u = 0; u < k.width; ++u) {
-      const Eigen::Vector3d ray = PixelRay(k, u, v);
-      const double x = ray.x() * kTop, y = ray.y() * kTop;
-      const bool on_top = tops[0].Contains(x, y) || tops[1].Contains(x, y);
-      // A shadow 3 cm wide around each (a Kinect's), the floor beyond.
-      const bool shadow = tops[0].Contains(x, y, 0.03) || tops[1].Contains(x, y, 0.03);
-      image.z[static_cast<size_t>(v) * k.width + u] = on_top ? static_cast<float>(kTop)
-                                                      : shadow
-                                                          ? std::numeric_limits<float>::quiet_NaN()
-                                                          : static_cast<float>(kFloor);
-    }
-  }
   FaceProposalOptions o;
   PlanarPatches pieces;
   const PlanarPatches merged = SegmentPlanarPatches(image, o.patches, &pieces);
@@ -428,29 +441,9 @@ TEST(FaceProposalsTest, FacesMergedAcrossAGapAreProposedFromTheirPieces) {
 // listed among the merged pieces (its outline, and so its faces, are the
 // patch's); the small one is.
 TEST(FaceProposalsTest, APieceHoldingNearlyAllOfItsMergedPatchIsNotAPiece) {
-  auto in_big = [](double x, double y, double m) {
-    return std::abs(x + 0.25) <= 0.4 + m && std::abs(y) <= 0.3 + m;
-  };
-  auto in_small = [](double x, double y, double m) {
-    const double c = std::cos(25.0 * M_PI / 180), s = std::sin(25.0 * M_PI / 180);
-    const double dx = x - 0.24, dy = y - 0.05;
-    return std::abs(c * dx + s * dy) <= 0.06 + m && std::abs(-s * dx + c * dy) <= 0.06 + m;
-  };
-  DepthImage image;
+  const DepthImage image =
+      TopsWithShadows({{{-0.25, 0.0}, 0.0, 0.4, 0.3}, {{0.24, 0.05}, 25.0, 0.06, 0.06}});
   const CameraIntrinsics& k = image.camera;
-  image.z.assign(static_cast<size_t>(k.width) * k.height, 0.0f);
-  for (int v = 0; v < k.height; ++v) {
-    for (int u = 0; u < k.width; ++u) {
-      const Eigen::Vector3d ray = PixelRay(k, u, v);
-      const double x = ray.x() * kTop, y = ray.y() * kTop;
-      const bool on_top = in_big(x, y, 0.0) || in_small(x, y, 0.0);
-      const bool shadow = in_big(x, y, 0.03) || in_small(x, y, 0.03);
-      image.z[static_cast<size_t>(v) * k.width + u] = on_top ? static_cast<float>(kTop)
-                                                      : shadow
-                                                          ? std::numeric_limits<float>::quiet_NaN()
-                                                          : static_cast<float>(kFloor);
-    }
-  }
   PlanarPatches pieces;
   const PlanarPatches merged = SegmentPlanarPatches(image, FaceProposalOptions{}.patches, &pieces);
   auto at = [&](const PlanarPatches& p, double x, double y) {
