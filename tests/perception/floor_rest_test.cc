@@ -47,7 +47,7 @@ int Rest(std::vector<DetectedBox>* boxes, const FloorRestOptions& options = {}) 
 }
 
 TEST(FloorRestTest, ABrickTiltedIntoTheFloorLiesFlatOnIt) {
-  for (const double tilt : {6.0, 8.0, -11.0, 13.5}) {
+  for (const double tilt : {2.5, 6.0, 8.0, -11.0, 13.5}) {  // 2.5: its bottom 1.9 mm in
     std::vector<DetectedBox> boxes{Brick(tilt)};
     const Eigen::Vector3d centre = boxes[0].grasp_centre_camera;
     ASSERT_EQ(Rest(&boxes), 1) << tilt;
@@ -68,7 +68,7 @@ TEST(FloorRestTest, BricksThatDoNotLieOnTheFloorKeepTheirPose) {
       Brick(8.0, 0.10),                     // on another box, 10 cm up
       Brick(20.0),                          // tilted past max_tilt_deg
       Brick(0.5),                           // within min_tilt_deg
-      Brick(4.0),                           // its bottom 3 mm into the floor: min_dip_m 4
+      Brick(1.2),                           // its bottom 0.9 mm into the floor: min_dip_m 1
   };
   const std::vector<DetectedBox> before = boxes;
   EXPECT_EQ(Rest(&boxes), 0);
