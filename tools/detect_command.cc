@@ -109,6 +109,8 @@ constexpr char kHelp[] =
     "                       box keeps its own)\n"
     "  --floor_rest DEG     a box on the floor whose bottom is tilted into it by up to\n"
     "                       DEG lies flat on it (15; 0: off)\n"
+    "  --corner_readings N  a corner proposes the N readings of its two edges that\n"
+    "                       fit them best (3; 0: every reading, up to six)\n"
     "  --seam_colour SHARE  with a colour image, a groove in the depth is a seam only\n"
     "                       where an image line runs along SHARE of the side (0.5;\n"
     "                       0: the depth alone)\n"
@@ -241,6 +243,7 @@ absl::Status Run(const CommandArgs& args) {
         args.SetDouble("layer_adopt", &options.layer_plane.adopt_angle_deg),
         args.SetInt("layer_turn", &options.layer_turn.min_agreeing),
         args.SetDouble("floor_rest", &options.floor_rest.max_tilt_deg),
+        args.SetInt("corner_readings", &options.pose.max_readings_per_corner),
         args.SetDouble("seam_colour", &options.refinement.colour_confirms_seam),
         args.SetDouble("sparse_seam", &options.refinement.sparse_seam_missing),
         args.SetDouble("eroded_faces", &options.faces.min_eroded_share),
@@ -384,6 +387,7 @@ int RunDetect(const std::vector<std::string>& argv) {
                                                        "layer_adopt",
                                                        "layer_turn",
                                                        "floor_rest",
+                                                       "corner_readings",
                                                        "seam_colour",
                                                        "sparse_seam",
                                                        "eroded_faces",

@@ -21,6 +21,10 @@ absl::Status PoseOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("corner_match_m=", corner_match_m, " is outside (0, 0.5] m"));
   }
+  if (max_readings_per_corner < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "max_readings_per_corner=", max_readings_per_corner, " is negative (0: every reading)"));
+  }
   return absl::OkStatus();
 }
 
@@ -54,6 +58,17 @@ std::vector<AxisAssignment> MatchEdgeLengths(double length1, double length2, con
     return x.length_cost < y.length_cost;
   });
   return out;
+}
+
+std::vector<AxisAssignment> CheapestReadings(std::vector<AxisAssignment> readings, int max_readings) {
+  if (max_readings <= 0 || static_cast<int>(readings.size()) <= max_readings) return readings;
+  // Ties with the last kept stay: which of two equal readings goes would
+  // depend on the order the axes are tried in.
+  const double last = readings[max_readings - 1].length_cost;
+  size_t keep = max_readings;
+  while (keep < readings.size() && readings[keep].length_cost <= last + 1e-12) ++keep;
+  readings.resize(keep);
+  return readings;
 }
 
 Eigen::Isometry3d PoseFromCorner(const Eigen::Vector3d& p1, const Eigen::Vector3d& d1_in,

@@ -898,7 +898,9 @@ void ProposeFromCorners(const Detection& det, const SegmentGroups& groups,
     const Eigen::Vector3d fb = (c.b_at_end1 ? sb.end2 : sb.end1).cast<double>();
     const double la = (fa - p1).norm(), lb = (fb - p1).norm();
     if (la < 1e-3 || lb < 1e-3) continue;
-    for (const AxisAssignment& as : MatchEdgeLengths(la, lb, options.box, options.pose)) {
+    for (const AxisAssignment& as :
+         CheapestReadings(MatchEdgeLengths(la, lb, options.box, options.pose),
+                          options.pose.max_readings_per_corner)) {
       Eigen::Isometry3d pose = PoseFromCorner(p1, fa - p1, fb - p1, as, options.box);
       const int corners = 1 + RefineWithCorners(group_corners[group_of[c.segment_a]], options.box,
                                                 options.pose, &pose);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "common/perception/pose_error.h"
@@ -77,6 +78,38 @@ TEST(MatchEdgeLengthsTest, RunOnEdgesNeedAllowRunOn) {
   EXPECT_TRUE(Contains(MatchEdgeLengths(0.45, 0.20, kCartonS, options), 0, 1));
   options.allow_run_on = false;
   EXPECT_TRUE(MatchEdgeLengths(0.45, 0.20, kCartonS, options).empty());
+}
+
+TEST(CheapestReadingsTest, KeepsTheCheapestAndTheirTies) {
+  // Two edges running on past every side: all six readings, the cheapest
+  // reads them as the two longest sides.
+  const std::vector<AxisAssignment> all = MatchEdgeLengths(0.45, 0.40, kCartonS, PoseOptions{});
+  ASSERT_EQ(all.size(), 6u);
+  const std::vector<AxisAssignment> three = CheapestReadings(all, 3);
+  ASSERT_EQ(three.size(), 3u);
+  for (size_t k = 0; k < three.size(); ++k) {
+    EXPECT_EQ(three[k].axis1, all[k].axis1);
+    EXPECT_EQ(three[k].axis2, all[k].axis2);
+  }
+  EXPECT_EQ(three[0].axis1, 0);
+  EXPECT_EQ(three[0].axis2, 1);
+  EXPECT_EQ(CheapestReadings(all, 0).size(), 6u);  // 0: every reading
+  EXPECT_EQ(CheapestReadings(all, 8).size(), 6u);
+  // A square box's l and b cost the same read either way: a tie with the
+  // last kept stays, whatever order the axes were tried in.
+  constexpr BoxDims kSquare{0.30, 0.30, 0.20};
+  const std::vector<AxisAssignment> square = MatchEdgeLengths(0.30, 0.20, kSquare, PoseOptions{});
+  ASSERT_GE(square.size(), 2u);
+  ASSERT_NEAR(square[0].length_cost, square[1].length_cost, 1e-12);
+  EXPECT_EQ(CheapestReadings(square, 1).size(), 2u);
+}
+
+TEST(CheapestReadingsTest, ANegativeCountIsRejectedByName) {
+  PoseOptions o;
+  o.max_readings_per_corner = -1;
+  const absl::Status s = o.Validate();
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(std::string(s.message()).find("max_readings_per_corner"), std::string::npos);
 }
 
 // The outward normal of `face` of a box at camera_T_box faces the camera.
