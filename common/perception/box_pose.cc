@@ -60,7 +60,8 @@ std::vector<AxisAssignment> MatchEdgeLengths(double length1, double length2, con
   return out;
 }
 
-std::vector<AxisAssignment> CheapestReadings(std::vector<AxisAssignment> readings, int max_readings) {
+std::vector<AxisAssignment> CheapestReadings(std::vector<AxisAssignment> readings,
+                                             int max_readings) {
   if (max_readings <= 0 || static_cast<int>(readings.size()) <= max_readings) return readings;
   // Ties with the last kept stay: which of two equal readings goes would
   // depend on the order the axes are tried in.
