@@ -94,7 +94,7 @@ constexpr char kHelp[] =
     "  --retake_outranked BOOL a box a check took out no longer blocks the readings\n"
     "                       it outranked: they are judged again (true)\n"
     "  --turned_proposals BOOL  a hypothesis declined for a side on flat proposes its\n"
-    "                       face turned a quarter at its measured corners (true)\n"
+    "                       face turned a quarter at its measured corners (false)\n"
     "  --unseen_sides BOOL  a side with nothing seen near it (a shadow) may hide a\n"
     "                       longer side of the box, as an occluded one does (true)\n"
     "  --unseen_longer S    ... unless S of the box so read longer is seen through\n"

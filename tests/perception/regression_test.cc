@@ -73,6 +73,20 @@ std::array<Detection, 2> DetectedWithRuleOffAndOn(
   return out;
 }
 
+// The frame's detection with the default options: none of its boxes wrong
+// (rules pinned as they were made, with options since changed, are checked
+// against the defaults too). Returns the boxes.
+size_t DefaultsReturnNoWrongBox(const PointCloud& cloud, const RenderedScene& r,
+                                const BoxDims& dims) {
+  DetectorOptions options;
+  options.box = dims;
+  const absl::StatusOr<Detection> det = DetectBoxes(cloud, options);
+  EXPECT_TRUE(det.ok()) << det.status();
+  if (!det.ok()) return 0;
+  EXPECT_EQ(WrongBoxes(*det, r), 0) << "with the default options";
+  return det->boxes.size();
+}
+
 // Frame `i` of one of scripts/evaluate's generated Kinect sets
 // (make_frames --sensor kinect --kind KIND --seed S renders frame i with
 // seed 1000 S + i), as the generator renders it.
@@ -919,9 +933,13 @@ TEST(RegressionTest, ACartonBesideOneFoundIsEndedByItWhereNoSeamShows) {
   const PointCloud cloud = RoundedToMillimetres(r);
   const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
       cloud, r, carton_l,
-      [](bool on, DetectorOptions* o) { o->acceptance.kept_box_ends_side = on; });
+      [](bool on, DetectorOptions* o) {
+        o->acceptance.kept_box_ends_side = on;
+        o->turned_proposals = true;  // as the rule was made (off since session 36)
+      });
   EXPECT_GE(det[1].boxes.size(), 4u);
   EXPECT_GT(det[1].boxes.size(), det[0].boxes.size());
+  EXPECT_GE(DefaultsReturnNoWrongBox(cloud, r, carton_l), 4u);
 }
 
 // Was: on a Kinect pallet layer of carton_l, two cartons side by side whose
@@ -998,6 +1016,7 @@ TEST(RegressionTest, AFarStereoPalletThatReturnedNothingIsDetectedWithAWiderWind
   auto detect = [&](int readings, int cells) {
     DetectorOptions o;
     o.box = carton_s;
+    o.turned_proposals = readings == 0;  // session 35's detector: turned proposals on
     o.pose.max_readings_per_corner = readings;
     o.empty_frame_window_cells = cells;
     absl::StatusOr<Detection> d = DetectBoxes(RoundedToMillimetres(r), o);
@@ -1219,9 +1238,11 @@ TEST(RegressionTest, ACartonStraddlingTwoOnTheirTapeEdgesIsTakenOut) {
         o->shifted_check = on;
         o->refinement.side_ends_share = 0.55;
         o->pose.max_readings_per_corner = 0;  // as the rule was made
+        o->turned_proposals = true;
       },
       /*wrong_without=*/true);
   EXPECT_GT(det[1].boxes.size(), det[0].boxes.size());
+  EXPECT_GE(DefaultsReturnNoWrongBox(RoundedToMillimetres(r), r, carton_flat), 10u);
 }
 
 // Was: a brick in a heap, lying on its side beside another whose face is
@@ -1320,7 +1341,8 @@ TEST(RegressionTest, TwoCartonsOnTheirSideThatAreOneCartonsTopAreTakenOut) {
       RoundedToMillimetres(r), r, carton_flat,
       [](bool on, DetectorOptions* o) {
         o->paired_check = on;
-        o->pose.max_readings_per_corner = 0;  // as the rule was made: every reading
+        o->pose.max_readings_per_corner = 0;  // as the rule was made: every reading,
+        o->turned_proposals = true;           // turned proposals on
       },
       /*wrong_without=*/true);
   // The cartons the pairs stood for are found instead.
@@ -1328,6 +1350,7 @@ TEST(RegressionTest, TwoCartonsOnTheirSideThatAreOneCartonsTopAreTakenOut) {
     return static_cast<int>(d.boxes.size()) - WrongBoxes(d, r);
   };
   EXPECT_GT(right(det[1]), right(det[0]));
+  DefaultsReturnNoWrongBox(RoundedToMillimetres(r), r, carton_flat);
 }
 
 // Was: a brick alone on the floor, seen by the active stereo camera, came
