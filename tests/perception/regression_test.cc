@@ -931,9 +931,8 @@ TEST(RegressionTest, ACartonBesideOneFoundIsEndedByItWhereNoSeamShows) {
   ASSERT_TRUE(frame.ok()) << frame.status();
   const RenderedScene& r = *frame;
   const PointCloud cloud = RoundedToMillimetres(r);
-  const std::array<Detection, 2> det = DetectedWithRuleOffAndOn(
-      cloud, r, carton_l,
-      [](bool on, DetectorOptions* o) {
+  const std::array<Detection, 2> det =
+      DetectedWithRuleOffAndOn(cloud, r, carton_l, [](bool on, DetectorOptions* o) {
         o->acceptance.kept_box_ends_side = on;
         o->turned_proposals = true;  // as the rule was made (off since session 36)
       });
